@@ -1,0 +1,165 @@
+// cli_common.cpp — option parsing and shared subcommand steps.
+#include "cli/cli_common.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+#include "core/assets.h"
+#include "core/error.h"
+
+namespace caustica::cli {
+
+Options::Options(std::string usage, std::string summary, std::vector<OptionSpec> specs)
+    : usage_(std::move(usage)), summary_(std::move(summary)), specs_(std::move(specs)) {
+  specs_.push_back({"--help", "-h", "", "show this help and exit"});
+}
+
+std::string Options::help() const {
+  std::ostringstream out;
+  out << "usage: " << usage_ << "\n\n" << summary_ << "\n\noptions:\n";
+  for (const auto& s : specs_) {
+    std::string left = "  " + (s.alias.empty() ? "" : s.alias + ", ") + s.name + (s.metavar.empty() ? "" : " " + s.metavar);
+    out << left;
+    if (left.size() < 30) out << std::string(30 - left.size(), ' ');
+    else out << "\n" << std::string(30, ' ');
+    out << s.help << "\n";
+  }
+  return out.str();
+}
+
+bool Options::parse(const std::vector<std::string>& args) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.size() < 2 || a[0] != '-') {
+      positional_.push_back(a);
+      continue;
+    }
+    std::string name = a, value;
+    bool inlineValue = false;
+    size_t eq = a.find('=');
+    if (a.rfind("--", 0) == 0 && eq != std::string::npos) {
+      name = a.substr(0, eq);
+      value = a.substr(eq + 1);
+      inlineValue = true;
+    }
+    const OptionSpec* spec = nullptr;
+    for (const auto& s : specs_)
+      if (s.name == name || (!s.alias.empty() && s.alias == name)) spec = &s;
+    if (!spec) throw Error("unknown option '" + a + "' (see --help)");
+    if (spec->name == "--help") {
+      std::cout << help();
+      return false;
+    }
+    if (spec->metavar.empty()) {
+      if (inlineValue) throw Error("option " + spec->name + " takes no value");
+      values_[spec->name] = "1";
+    } else {
+      if (!inlineValue) {
+        if (i + 1 >= args.size()) throw Error("option " + spec->name + " needs a value (" + spec->metavar + ")");
+        value = args[++i];
+      }
+      values_[spec->name] = value;
+    }
+  }
+  return true;
+}
+
+std::string Options::get(const std::string& name, const std::string& fallback) const {
+  auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+int Options::getInt(const std::string& name, int fallback, int lo, int hi) const {
+  auto it = values_.find(name);
+  if (it == values_.end()) return fallback;
+  const std::string& v = it->second;
+  char* end = nullptr;
+  long n = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || n < lo || n > hi)
+    throw Error("option " + name + " needs an integer from " + std::to_string(lo) + " to " + std::to_string(hi) +
+                ", got '" + v + "'");
+  return static_cast<int>(n);
+}
+
+double Options::getDouble(const std::string& name, double fallback) const {
+  auto it = values_.find(name);
+  if (it == values_.end()) return fallback;
+  char* end = nullptr;
+  double d = std::strtod(it->second.c_str(), &end);
+  if (it->second.empty() || *end != '\0' || !std::isfinite(d))
+    throw Error("option " + name + " needs a number, got '" + it->second + "'");
+  return d;
+}
+
+std::vector<OptionSpec> sceneOptionSpecs() {
+  return {
+      {"--size", "", "W[xH]", "image size in pixels (default 512; H follows the camera's aspect)"},
+      {"--seed", "", "S", "random seed (default 1); the same seed gives the same image"},
+      {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
+      {"--dispersion", "", "MODE", "rgb (one channel per path; default) or spectral (hero wavelength)"},
+      {"--max-depth", "", "N", "maximum path length in bounces (default 32)"},
+      {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
+      {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
+      {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
+      {"--quiet", "-q", "", "print nothing but errors"},
+  };
+}
+
+void parseSize(const std::string& text, float cameraAspect, int& width, int& height) {
+  size_t x = text.find('x');
+  auto num = [&](const std::string& s) {
+    char* end = nullptr;
+    long n = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || *end != '\0' || n < 1 || n > 16384) throw Error("bad --size '" + text + "' (expected W or WxH, 1 to 16384)");
+    return static_cast<int>(n);
+  };
+  if (x == std::string::npos) {
+    width = num(text);
+    height = cameraAspect > 0.0f ? std::max(1, static_cast<int>(std::lround(width / cameraAspect))) : width;
+  } else {
+    width = num(text.substr(0, x));
+    height = num(text.substr(x + 1));
+  }
+}
+
+void note(bool quiet, const std::string& line) {
+  if (!quiet) std::cerr << "caustica: " << line << "\n";
+}
+
+LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
+  if (opts.positional().size() > 1) throw Error("expected one scene, got " + std::to_string(opts.positional().size()));
+  std::string arg = opts.positional().empty() ? kDefaultScene : opts.positional()[0];
+  std::string path = resolveScenePath(arg);
+  LoadedScene ls;
+  ls.scene = loadScene(path);
+  for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
+  int index = opts.getInt("--camera", 0, 0, 1 << 20);
+  if (ls.scene.cameras.empty()) {
+    if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");
+    ls.camera = autoCamera(ls.scene.bounds);
+  } else {
+    if (index >= static_cast<int>(ls.scene.cameras.size()))
+      throw Error(path + ": --camera " + std::to_string(index) + " but the scene has " +
+                  std::to_string(ls.scene.cameras.size()) + " camera(s)");
+    ls.camera = ls.scene.cameras[static_cast<size_t>(index)];
+  }
+  return ls;
+}
+
+RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
+  RenderSettings s;
+  parseSize(opts.get("--size", std::to_string(defaultWidth)), camera.aspect, s.width, s.height);
+  s.seed = static_cast<std::uint32_t>(opts.getInt("--seed", 1, 0, 2147483647));
+  s.maxDepth = opts.getInt("--max-depth", 32, 1, 1024);
+  s.integrator = parseIntegrator(opts.get("--integrator", "mis"));
+  s.dispersion = parseDispersionMode(opts.get("--dispersion", "rgb"));
+  return s;
+}
+
+ShaderLibrary shaderLibraryFrom(const Options& opts) { return ShaderLibrary(opts.get("--shader-dir", "")); }
+
+}  // namespace caustica::cli

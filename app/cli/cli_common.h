@@ -1,0 +1,62 @@
+// cli_common.h — the small option parser every subcommand uses, and the steps they share
+// (scene loading, camera choice, image size, context creation).
+#pragma once
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/gl_context.h"
+#include "core/renderer.h"
+#include "core/scene.h"
+#include "core/shader_library.h"
+
+namespace caustica::cli {
+
+struct OptionSpec {
+  std::string name;      // "--spp"
+  std::string alias;     // "-o" or ""
+  std::string metavar;   // "N"; empty for a flag
+  std::string help;
+};
+
+class Options {
+ public:
+  Options(std::string usage, std::string summary, std::vector<OptionSpec> specs);
+  // Parses args (after the subcommand). Returns false if --help was given (help already printed).
+  // Throws Error on unknown options or missing values.
+  bool parse(const std::vector<std::string>& args);
+  bool has(const std::string& name) const { return values_.count(name) > 0; }
+  std::string get(const std::string& name, const std::string& fallback) const;
+  int getInt(const std::string& name, int fallback, int lo, int hi) const;
+  double getDouble(const std::string& name, double fallback) const;
+  const std::vector<std::string>& positional() const { return positional_; }
+  std::string help() const;
+
+ private:
+  std::string usage_, summary_;
+  std::vector<OptionSpec> specs_;
+  std::map<std::string, std::string> values_;
+  std::vector<std::string> positional_;
+};
+
+// Options shared by render, view and bench.
+std::vector<OptionSpec> sceneOptionSpecs();
+
+// Parses "W" or "WxH". With only W, H follows the camera's aspect ratio (or is W).
+void parseSize(const std::string& text, float cameraAspect, int& width, int& height);
+
+struct LoadedScene {
+  Scene scene;
+  Camera camera;
+};
+// Loads the scene argument (bare name or path) and picks --camera N (default 0; automatic if none).
+LoadedScene loadSceneForCli(const Options& opts, bool verbose);
+
+RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth);
+ShaderLibrary shaderLibraryFrom(const Options& opts);
+
+// Prints a line to stderr with the "caustica: " prefix unless quiet.
+void note(bool quiet, const std::string& line);
+
+}  // namespace caustica::cli

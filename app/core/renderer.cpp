@@ -1,0 +1,244 @@
+// renderer.cpp — scene upload, shader variants, dispatch and readback for the GPU path tracer.
+#include "core/renderer.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace caustica {
+
+Integrator parseIntegrator(const std::string& name) {
+  if (name == "naive") return Integrator::Naive;
+  if (name == "mis") return Integrator::Mis;
+  throw Error("unknown integrator '" + name + "' (expected naive or mis)");
+}
+
+DispersionMode parseDispersionMode(const std::string& name) {
+  if (name == "rgb") return DispersionMode::Rgb;
+  if (name == "spectral") return DispersionMode::Spectral;
+  throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
+}
+
+const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
+const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
+
+GlLimits queryGlLimits() {
+  GlLimits l;
+  GLint64 block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  l.maxStorageBlockSize = block;
+  glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &l.maxComputeStorageBlocks);
+  glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &l.maxWorkGroupInvocations);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.maxTextureSize);
+  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &l.maxWorkGroupCount[0]);
+  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &l.maxWorkGroupCount[1]);
+  return l;
+}
+
+namespace {
+
+std::string mib(double bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
+  return buf;
+}
+
+void checkImageSize(const GlLimits& l, int w, int h) {
+  if (w < 1 || h < 1) throw Error("image size must be at least 1x1");
+  if (w > l.maxTextureSize || h > l.maxTextureSize)
+    throw Error("image size " + std::to_string(w) + "x" + std::to_string(h) + " exceeds this GPU's texture limit of " +
+                std::to_string(l.maxTextureSize));
+  int gx = (w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X, gy = (h + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y;
+  if (gx > l.maxWorkGroupCount[0] || gy > l.maxWorkGroupCount[1]) throw Error("image too large for one compute dispatch");
+}
+
+}  // namespace
+
+Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
+    : library_(library), settings_(settings), camera_(camera) {
+  limits_ = queryGlLimits();
+  if (limits_.maxComputeStorageBlocks < CAUSTICA_SSBO_COUNT)
+    throw Error("this GPU allows " + std::to_string(limits_.maxComputeStorageBlocks) +
+                " storage buffers per compute shader; caustica needs " + std::to_string(CAUSTICA_SSBO_COUNT));
+  if (limits_.maxWorkGroupInvocations < CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y)
+    throw Error("this GPU's compute work groups are too small");
+  checkImageSize(limits_, settings_.width, settings_.height);
+  if (settings_.maxDepth < 1 || settings_.maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
+
+  auto t0 = std::chrono::steady_clock::now();
+  bvh_ = buildBvh(scene.triangles);
+  bvhSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  gpuScene_ = packScene(scene, bvh_);
+
+  auto sized = [&](const char* what, size_t bytes) {
+    if (static_cast<std::int64_t>(bytes) > limits_.maxStorageBlockSize)
+      throw Error(scene.path + ": " + what + " need " + mib(static_cast<double>(bytes)) +
+                  " but this GPU allows " + mib(static_cast<double>(limits_.maxStorageBlockSize)) +
+                  " per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE)");
+  };
+  const GpuScene& g = gpuScene_;
+  sized("BVH nodes", g.nodes.size() * sizeof(gpu::BvhNode));
+  sized("triangles", g.triShade.size() * sizeof(gpu::TriShade));
+  sized("materials", g.materials.size() * sizeof(gpu::Material));
+  sized("emitters", g.emitters.size() * sizeof(gpu::Emitter));
+  sized("textures", g.texels.size() * 4);
+
+  buffers_.resize(CAUSTICA_SSBO_COUNT);
+  buffers_[CAUSTICA_BINDING_NODES] = GlBuffer::fromVector(g.nodes);
+  buffers_[CAUSTICA_BINDING_TRIGEOM] = GlBuffer::fromVector(g.triGeom);
+  buffers_[CAUSTICA_BINDING_TRISHADE] = GlBuffer::fromVector(g.triShade);
+  buffers_[CAUSTICA_BINDING_MATERIALS] = GlBuffer::fromVector(g.materials);
+  buffers_[CAUSTICA_BINDING_EMITTERS] = GlBuffer::fromVector(g.emitters);
+  buffers_[CAUSTICA_BINDING_TEXELS] = GlBuffer::fromVector(g.texels);
+  buffers_[CAUSTICA_BINDING_TEXINFO] = GlBuffer::fromVector(g.texInfo);
+  buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
+  frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
+  resize(settings_.width, settings_.height);
+  program();  // compile now, so shader errors surface before rendering starts
+}
+
+std::vector<std::string> Renderer::shaderDefines() const {
+  std::vector<std::string> d = gpuScene_.features.defines();
+  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) d.push_back("CAUSTICA_MIS");
+  if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
+  return d;
+}
+
+const GlProgram& Renderer::program() {
+  std::vector<std::string> defines = shaderDefines();
+  std::string key;
+  for (const auto& d : defines) key += d + " ";
+  auto it = programs_.find(key);
+  if (it != programs_.end()) return it->second;
+  ExpandedShader src = library_.expand("pathtrace.comp", defines);
+  GlProgram p = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
+                                          "pathtrace.comp");
+  return programs_.emplace(key, std::move(p)).first->second;
+}
+
+void Renderer::setCamera(const Camera& camera) {
+  camera_ = camera;
+  reset();
+}
+void Renderer::setIntegrator(Integrator integrator) {
+  settings_.integrator = integrator;
+  program();
+  reset();
+}
+void Renderer::setDispersionMode(DispersionMode mode) {
+  settings_.dispersion = mode;
+  program();
+  reset();
+}
+void Renderer::setMaxDepth(int maxDepth) {
+  if (maxDepth < 1 || maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
+  settings_.maxDepth = maxDepth;
+  reset();
+}
+
+void Renderer::resize(int width, int height) {
+  checkImageSize(limits_, width, height);
+  settings_.width = width;
+  settings_.height = height;
+  accum_ = GlTexture::create2D(width, height, GL_RGBA32F);
+  comp_ = GlTexture::create2D(width, height, GL_RGBA32F);
+  display_ = GlTexture();
+  reset();
+}
+
+void Renderer::reset() {
+  accum_.clear();
+  comp_.clear();
+  spp_ = 0;
+  sampleBase_ = 0;
+  stats_ = RenderStats{};
+  gpu::Counters zero{};
+  buffers_[CAUSTICA_BINDING_COUNTERS].update(0, sizeof zero, &zero);
+}
+
+void Renderer::renderRows(int y0, int y1, int spp) {
+  y0 = std::max(0, y0);
+  y1 = std::min(settings_.height, y1);
+  if (y1 <= y0 || spp <= 0) return;
+  const GlProgram& prog = program();
+  const int w = settings_.width, h = settings_.height;
+  float aspect = static_cast<float>(w) / static_cast<float>(h);
+  float tanHalf = std::tan(0.5f * camera_.yfov);
+  glm::vec3 fwd = glm::normalize(camera_.forward);
+  glm::vec3 right = glm::normalize(glm::cross(fwd, camera_.up));
+  glm::vec3 up = glm::cross(right, fwd);
+  gpu::FrameParams fp{};
+  fp.camPos = glm::vec4(camera_.position, 1.0f);
+  fp.camRight = glm::vec4(right * tanHalf * aspect, 0.0f);
+  fp.camUp = glm::vec4(up * tanHalf, 0.0f);
+  fp.camForward = glm::vec4(fwd, 0.0f);
+  fp.frame = glm::uvec4(w, h, sampleBase_, settings_.seed);
+  fp.options = glm::uvec4(settings_.maxDepth, spp, gpuScene_.emitters.size(),
+                          (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
+                              (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
+  fp.tile = glm::uvec4(0, y0, w, y1 - y0);
+  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 1.0f, 0.0f, 0.0f);
+  frameUbo_.update(0, sizeof fp, &fp);
+
+  prog.use();
+  for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
+  frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
+  accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
+  comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
+  glDispatchCompute((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
+                    (y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+                  GL_TEXTURE_UPDATE_BARRIER_BIT);
+  checkGlError("path tracing dispatch");
+  readCounters();
+}
+
+void Renderer::endPass(int spp) {
+  spp_ += spp;
+  sampleBase_ += static_cast<std::uint32_t>(spp);
+}
+
+void Renderer::readCounters() {
+  gpu::Counters c{};
+  GlBuffer& buf = buffers_[CAUSTICA_BINDING_COUNTERS];
+  buf.read(0, sizeof c, &c);
+  stats_.primaryRays += c.primaryRays;
+  stats_.secondaryRays += c.secondaryRays;
+  stats_.shadowRays += c.shadowRays;
+  stats_.nonFinite += c.nonFinite;
+  gpu::Counters zero{};
+  buf.update(0, sizeof zero, &zero);
+}
+
+Image Renderer::image() const {
+  std::vector<float> rgba = accum_.readRgba32f();
+  Image img{settings_.width, settings_.height, std::vector<float>(static_cast<size_t>(settings_.width) * settings_.height * 3)};
+  for (size_t i = 0; i < static_cast<size_t>(settings_.width) * settings_.height; ++i) {
+    float n = rgba[i * 4 + 3];
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = n > 0.0f ? rgba[i * 4 + c] / n : 0.0f;
+  }
+  return img;
+}
+
+const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {
+  if (!tonemapProgram_.id()) {
+    ExpandedShader src = library_.expand("tonemap.comp", {});
+    tonemapProgram_ = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
+                                                "tonemap.comp");
+  }
+  if (display_.width() != settings_.width || display_.height() != settings_.height)
+    display_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA8);
+  tonemapProgram_.use();
+  glUniform1f(0, std::exp2(tone.exposureStops));
+  glUniform1i(1, static_cast<int>(tone.curve));
+  accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_ONLY);
+  display_.bindImage(CAUSTICA_IMAGE_DISPLAY, GL_WRITE_ONLY);
+  glDispatchCompute((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
+                    (settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
+  glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+  checkGlError("tone mapping");
+  return display_;
+}
+
+}  // namespace caustica

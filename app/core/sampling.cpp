@@ -1,0 +1,116 @@
+// sampling.cpp — C++ twins of the shader sampling routines (see sampling.h).
+#include "core/sampling.h"
+
+#include <cmath>
+#include <cstring>
+
+namespace caustica {
+
+std::uint32_t pcgHash(std::uint32_t v) {
+  std::uint32_t state = v * 747796405u + 2891336453u;
+  std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+std::uint32_t rngSeed(std::uint32_t pixel, std::uint32_t sampleIndex, std::uint32_t seed) {
+  return pcgHash(pixel ^ pcgHash(sampleIndex ^ pcgHash(seed)));
+}
+
+float rand01(std::uint32_t& state) {
+  state = state * 747796405u + 2891336453u;
+  std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  word = (word >> 22u) ^ word;
+  return static_cast<float>(word >> 8u) * (1.0f / 16777216.0f);
+}
+
+float luminance(const glm::vec3& c) { return glm::dot(c, glm::vec3(0.2126f, 0.7152f, 0.0722f)); }
+
+void orthonormalBasis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  float s = n.z >= 0.0f ? 1.0f : -1.0f;
+  float a = -1.0f / (s + n.z);
+  float c = n.x * n.y * a;
+  t = glm::vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+  b = glm::vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+glm::vec3 sampleCosineHemisphere(const glm::vec2& u) {
+  float r = std::sqrt(u.x);
+  float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x))};
+}
+
+glm::vec2 sampleTriangleUniform(const glm::vec2& u) {
+  float su = std::sqrt(u.x);
+  return {1.0f - su, u.y * su};
+}
+
+float powerHeuristic(float a, float b) {
+  if (std::isinf(a)) return 1.0f;
+  float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+float fresnelDielectric(float cosI, float eta) {
+  cosI = glm::clamp(cosI, 0.0f, 1.0f);
+  float sin2T = (1.0f - cosI * cosI) / (eta * eta);
+  if (sin2T >= 1.0f) return 1.0f;
+  float cosT = std::sqrt(std::max(0.0f, 1.0f - sin2T));
+  float rs = (cosI - eta * cosT) / (cosI + eta * cosT);
+  float rp = (eta * cosI - cosT) / (eta * cosI + cosT);
+  return 0.5f * (rs * rs + rp * rp);
+}
+
+bool refractDir(const glm::vec3& d, const glm::vec3& n, float eta, glm::vec3& t) {
+  float cosI = -glm::dot(d, n);
+  float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);
+  if (sin2T >= 1.0f) {
+    t = glm::vec3(0.0f);
+    return false;
+  }
+  float cosT = std::sqrt(1.0f - sin2T);
+  t = glm::normalize(eta * d + (eta * cosI - cosT) * n);
+  return true;
+}
+
+float sampleDielectric(const glm::vec3& d, const glm::vec3& n, float eta, float u, glm::vec3& wi, bool& transmitted) {
+  float cosI = -glm::dot(d, n);
+  float f = fresnelDielectric(cosI, eta);
+  if (u < f || !refractDir(d, n, 1.0f / eta, wi)) {
+    wi = glm::reflect(d, n);
+    transmitted = false;
+    return 1.0f;
+  }
+  transmitted = true;
+  return 1.0f / (eta * eta);
+}
+
+glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n) {
+  constexpr float kOrigin = 1.0f / 32.0f, kFloatScale = 1.0f / 65536.0f, kIntScale = 256.0f;
+  glm::vec3 out;
+  for (int i = 0; i < 3; ++i) {
+    int of = static_cast<int>(kIntScale * n[i]);
+    std::int32_t bits;
+    std::memcpy(&bits, &p[i], 4);
+    bits += p[i] < 0.0f ? -of : of;
+    float pi;
+    std::memcpy(&pi, &bits, 4);
+    out[i] = std::fabs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : pi;
+  }
+  return out;
+}
+
+float cauchyIor(float iorD, float abbe, float lambdaNm) {
+  if (abbe <= 0.0f) return iorD;
+  const float lF = 486.1f, lC = 656.3f, lD = 587.6f;
+  float b = (iorD - 1.0f) / (abbe * (1.0f / (lF * lF) - 1.0f / (lC * lC)));
+  float a = iorD - b / (lD * lD);
+  return a + b / (lambdaNm * lambdaNm);
+}
+
+glm::vec3 channelSensitivity(float lambdaNm) {
+  const glm::vec3 mean(610.0f, 545.0f, 460.0f), sigma(30.0f, 30.0f, 22.0f);
+  glm::vec3 x = (glm::vec3(lambdaNm) - mean) / sigma;
+  return glm::exp(-0.5f * x * x) / (sigma * 2.50662827463f);
+}
+
+}  // namespace caustica

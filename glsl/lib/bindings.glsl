@@ -1,0 +1,14 @@
+// bindings.glsl — GLSL declarations of every buffer and image the path tracer reads or writes.
+// Struct layouts come from glsl/shared/gpu_layout.h (shared with C++); this file only binds them.
+#include "../shared/gpu_layout.h"
+
+layout(std430, binding = CAUSTICA_BINDING_NODES) readonly buffer NodeBuffer { BvhNode nodes[]; };
+layout(std430, binding = CAUSTICA_BINDING_TRIGEOM) readonly buffer TriGeomBuffer { TriGeom triGeom[]; };
+layout(std430, binding = CAUSTICA_BINDING_TRISHADE) readonly buffer TriShadeBuffer { TriShade triShade[]; };
+layout(std430, binding = CAUSTICA_BINDING_MATERIALS) readonly buffer MaterialBuffer { Material materials[]; };
+layout(std430, binding = CAUSTICA_BINDING_EMITTERS) readonly buffer EmitterBuffer { Emitter emitters[]; };
+layout(std430, binding = CAUSTICA_BINDING_TEXELS) readonly buffer TexelBuffer { uint texels[]; };
+layout(std430, binding = CAUSTICA_BINDING_TEXINFO) readonly buffer TexInfoBuffer { TexInfo texInfo[]; };
+layout(std430, binding = CAUSTICA_BINDING_COUNTERS) buffer CounterBuffer { Counters counters; };
+
+layout(std140, binding = CAUSTICA_BINDING_FRAME) uniform FrameBlock { FrameParams frame; };

@@ -1,0 +1,78 @@
+// intersect.glsl — watertight ray–triangle test and ray–box slab test (world space; t in units of |dir|).
+// Twins of intersectTriangle() and intersectAabb() in app/core/bvh.cpp; keep the two in step.
+
+// Cyclic permutation that moves axis kz to z (keeps handedness; both faces are accepted anyway).
+vec3 permuteToKz(vec3 a, int kz) {
+  return kz == 0 ? a.yzx : (kz == 1 ? a.zxy : a);
+}
+
+// Woop, Benthin, Wald 2013, in the form of pbrt-v4's IntersectTriangle: translate to the ray origin,
+// permute the largest direction component to z, shear the ray onto +z, then 2D edge functions.
+// Shared edges give exactly negated edge functions, so no ray slips between two triangles; `precise`
+// forbids fused multiply-adds that would break that symmetry. Returns true when 0 < t < tmax; u and v
+// are the barycentric weights of p1 and p2. Degenerate (zero-area) triangles never hit.
+// Difference from the C++ twin: no double-precision recomputation when an edge function is exactly 0
+// (such a ray counts as on the edge, so it may hit both neighbours; watertightness is unaffected).
+bool intersectTriangle(vec3 org, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float tmax,
+                       out float t, out float u, out float v) {
+  t = 0.0;
+  u = 0.0;
+  v = 0.0;
+  vec3 ad = abs(dir);
+  int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+  vec3 d = permuteToKz(dir, kz);
+  if (d.z == 0.0) return false;  // zero direction
+  float sz = 1.0 / d.z;
+  float sx = -d.x * sz;
+  float sy = -d.y * sz;
+
+  vec3 a = permuteToKz(p0 - org, kz);
+  vec3 b = permuteToKz(p1 - org, kz);
+  vec3 c = permuteToKz(p2 - org, kz);
+  precise float ax = a.x + sx * a.z;
+  precise float ay = a.y + sy * a.z;
+  precise float bx = b.x + sx * b.z;
+  precise float by = b.y + sy * b.z;
+  precise float cx = c.x + sx * c.z;
+  precise float cy = c.y + sy * c.z;
+
+  precise float e0 = bx * cy - by * cx;  // edge function opposite p0 (weight of p0)
+  precise float e1 = cx * ay - cy * ax;  // opposite p1
+  precise float e2 = ax * by - ay * bx;  // opposite p2
+  if ((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0)) return false;
+  float det = e0 + e1 + e2;
+  if (det == 0.0) return false;  // ray in the triangle's plane
+  // Zero-area triangles can pass the test above once their vertices are rounded in ray space.
+  if (all(equal(cross(p1 - p0, p2 - p0), vec3(0.0)))) return false;
+
+  float tScaled = e0 * (sz * a.z) + e1 * (sz * b.z) + e2 * (sz * c.z);
+  float invDet = 1.0 / det;
+  float tt = tScaled * invDet;
+  if (!(tt > 0.0 && tt < tmax)) return false;  // also rejects NaN
+  t = tt;
+  u = e1 * invDet;
+  v = e2 * invDet;
+  return true;
+}
+
+// Slab test against [bmin, bmax]; invDir comes from safeInverse() (finite: no 0 * inf = NaN).
+// tnear: entry distance clamped to >= 0. The exit distance is widened by 2^-20 (relative) to cover
+// rounding, and an exit distance of exactly 0 (origin on a slab plane with a ~0 direction component)
+// counts as "inside", so rays lying on a box face still visit it. Both are conservative.
+bool intersectAabb(vec3 org, vec3 invDir, vec3 bmin, vec3 bmax, float tmax, out float tnear) {
+  vec3 t0 = (bmin - org) * invDir;
+  vec3 t1 = (bmax - org) * invDir;
+  vec3 lo = min(t0, t1);
+  vec3 hi = max(t0, t1);
+  hi = mix(hi, vec3(3.0e38), equal(hi, vec3(0.0)));
+  tnear = max(max(lo.x, lo.y), max(lo.z, 0.0));
+  float tfar = min(min(hi.x, hi.y), min(hi.z, tmax)) * (1.0 + 1.0 / 1048576.0);
+  return tnear <= tfar;
+}
+
+// Guarded reciprocal of a ray direction: |d| < 1e-20 becomes +-1e-20 (sign by d >= 0), so the
+// result is finite and never 0 * inf = NaN in the slab test.
+vec3 safeInverse(vec3 d) {
+  vec3 g = mix(vec3(-1e-20), vec3(1e-20), greaterThanEqual(d, vec3(0.0)));
+  return 1.0 / mix(d, g, lessThan(abs(d), vec3(1e-20)));
+}

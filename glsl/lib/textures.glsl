@@ -1,0 +1,39 @@
+// textures.glsl — bilinear lookup of RGBA8 sRGB textures stored in one SSBO (see TexInfo in
+// gpu_layout.h). Texels are decoded to linear before filtering. uv in glTF convention (v down).
+
+vec3 srgbToLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+int wrapCoord(int i, int n, bool repeat, bool mirror) {
+  if (mirror) {
+    int period = 2 * n;
+    int m = ((i % period) + period) % period;
+    return m < n ? m : period - 1 - m;
+  }
+  if (repeat) return ((i % n) + n) % n;
+  return clamp(i, 0, n - 1);
+}
+
+vec4 fetchTexel(TexInfo info, int x, int y) {
+  uint w = info.width, h = info.height;
+  x = wrapCoord(x, int(w), (info.flags & 1u) != 0u, (info.flags & 4u) != 0u);
+  y = wrapCoord(y, int(h), (info.flags & 2u) != 0u, (info.flags & 8u) != 0u);
+  vec4 c = unpackUnorm4x8(texels[info.offset + uint(y) * w + uint(x)]);
+  return vec4(srgbToLinear(c.rgb), c.a);
+}
+
+// Linear RGB and alpha of texture `index` at uv.
+vec4 sampleTexture(uint index, vec2 uv) {
+  TexInfo info = texInfo[index];
+  // Keep the coordinate bounded before converting to int (huge uv would overflow).
+  vec2 st = uv * vec2(float(info.width), float(info.height));
+  st = clamp(st, vec2(-1.0e7), vec2(1.0e7));
+  if ((info.flags & 16u) != 0u) return fetchTexel(info, int(floor(st.x)), int(floor(st.y)));
+  st -= 0.5;
+  vec2 f = fract(st);
+  int x0 = int(floor(st.x)), y0 = int(floor(st.y));
+  vec4 a = mix(fetchTexel(info, x0, y0), fetchTexel(info, x0 + 1, y0), f.x);
+  vec4 b = mix(fetchTexel(info, x0, y0 + 1), fetchTexel(info, x0 + 1, y0 + 1), f.x);
+  return mix(a, b, f.y);
+}

@@ -1,0 +1,204 @@
+// pathtrace.comp — the path tracer entry shader: one invocation per pixel, `options.y` samples per
+// dispatch, eye rays bounce until they reach emitters (naive) or also sample lights (CAUSTICA_MIS).
+// Radiance is linear; throughput is per RGB channel; wavelengths in nm.
+#include "lib/bindings.glsl"
+#include "lib/rng.glsl"
+#include "lib/sampling.glsl"
+#include "lib/intersect.glsl"
+#include "lib/traverse.glsl"
+#include "lib/camera.glsl"
+#include "lib/textures.glsl"
+#include "lib/spectral.glsl"
+#include "lib/materials.glsl"
+#include "lib/lights.glsl"
+#include "lib/accumulate.glsl"
+
+layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
+
+shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samples
+
+uint gSecondaryRays = 0u;
+uint gShadowRays = 0u;
+
+// One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
+vec3 tracePath(uvec2 pixel, inout uint rng) {
+  vec3 org = frame.camPos.xyz;
+  vec3 dir = eyeRayDirection(pixel, rand2(rng));
+  vec3 beta = vec3(1.0);   // path throughput
+  vec3 radiance = vec3(0.0);
+  vec3 filt = vec3(1.0);   // per-channel weight of the wavelength(s) the path carries (dispersion)
+  float lambda = 0.0;      // nm; 0 while the path still carries every wavelength
+  float prevPdf = 0.0;     // solid-angle pdf of the last BSDF sample (diffuse lobe)
+  bool prevDelta = true;   // last direction came from the camera or a delta lobe: no MIS on emitter hits
+  vec3 sigma = vec3(0.0);  // absorption coefficient of the medium the ray travels in (per scene unit)
+  uint maxDepth = frame.options.x;
+
+  for (uint depth = 0u; depth < maxDepth; ++depth) {
+    if (depth > 0u) ++gSecondaryRays;
+    Hit hit;
+    if (!traceClosest(org, dir, 3.0e38, hit)) break;
+#ifdef CAUSTICA_VOLUME
+    beta *= exp(-sigma * hit.t);
+#endif
+    TriGeom g = triGeom[hit.tri];
+    TriShade s = triShade[hit.tri];
+    float b0 = 1.0 - hit.u - hit.v;
+    vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
+    vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
+    float crLen = length(cr);
+    if (!(crLen > 0.0)) break;
+    vec3 ngFront = cr / crLen;              // geometric normal of the front (counter-clockwise) face
+    bool front = dot(dir, ngFront) < 0.0;
+    vec3 ng = front ? ngFront : -ngFront;   // geometric normal on the side the ray came from
+    vec3 nsRaw = b0 * s.n0.xyz + hit.u * s.n1.xyz + hit.v * s.n2.xyz;
+    float nsLen = length(nsRaw);
+    vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
+    if (dot(ns, ngFront) < 0.0) ns = -ns;
+    if (!front) ns = -ns;                   // shading normal on the side the ray came from
+    vec2 uv = b0 * vec2(s.n0.w, s.vt.x) + hit.u * vec2(s.n1.w, s.vt.y) + hit.v * vec2(s.n2.w, s.vt.z);
+    Material m = materials[floatBitsToUint(g.v0.w)];
+
+    // Emission, weighted against light sampling when the last bounce could have sampled it.
+    if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) {
+      float w = 1.0;
+#ifdef CAUSTICA_MIS
+      if (!prevDelta) {
+        float pdfLight = lightPdfArea(m) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
+        w = powerHeuristic(prevPdf, pdfLight);
+      }
+#endif
+      radiance += beta * filt * materialEmission(m, uv) * w;
+    }
+
+    vec4 base = materialBaseColor(m, uv);
+#ifdef CAUSTICA_OPACITY
+    if (base.a < 1.0 && rand01(rng) >= base.a) {  // pass straight through (a delta event)
+      org = offsetRayOrigin(p, -ng);
+      prevDelta = true;
+      continue;
+    }
+#endif
+
+    vec3 newDir;
+    uint lobe = chooseLobe(m, rand01(rng));
+    if (lobe == kLobeDiffuse) {
+#ifdef CAUSTICA_MIS
+      LightSample ls;
+      if (sampleLight(rand01(rng), rand01(rng), rand2(rng), ls)) {
+        vec3 toLight = ls.p - p;
+        float dist2 = dot(toLight, toLight);
+        float dist = sqrt(dist2);
+        vec3 wl = toLight / max(dist, 1.0e-30);
+        float cosLight = -dot(ls.n, wl);
+        float cosSurf = dot(ns, wl);
+        if ((cosLight > 0.0 || (ls.twoSided && cosLight < 0.0)) && cosSurf > 0.0 && dot(ng, wl) > 0.0 && dist > 0.0) {
+          cosLight = abs(cosLight);
+          float pdfLight = ls.pdfArea * dist2 / cosLight;
+          ++gShadowRays;
+          // Stop just short of the light so its own triangle (and coplanar neighbours) do not occlude.
+          if (!traceOccluded(offsetRayOrigin(p, ng), wl, dist * (1.0 - 1.0e-4))) {
+            float w = powerHeuristic(pdfLight, cosSurf * INV_PI);
+            radiance += beta * filt * base.rgb * (INV_PI * cosSurf * w / pdfLight) * ls.le;
+          }
+        }
+      }
+#endif
+      vec3 t, b;
+      orthonormalBasis(ns, t, b);
+      vec3 local = sampleCosineHemisphere(rand2(rng));
+      newDir = normalize(local.x * t + local.y * b + local.z * ns);
+      float cosOut = dot(newDir, ns);
+      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) break;  // below the true surface: absorbed
+      beta *= base.rgb;
+      prevPdf = cosOut * INV_PI;
+      prevDelta = false;
+    }
+#ifdef CAUSTICA_MIRROR
+    else if (lobe == kLobeMirror) {
+      newDir = reflect(dir, ns);
+      if (dot(newDir, ng) <= 0.0) newDir = reflect(dir, ng);
+      beta *= base.rgb;
+      prevDelta = true;
+    }
+#endif
+#ifdef CAUSTICA_GLASS
+    else {
+      float ior = m.params.w;
+#ifdef CAUSTICA_DISPERSION
+      if ((m.tex.z & kMatDispersive) != 0u) {
+        if (lambda == 0.0) {  // the path keeps one wavelength from its first dispersive event on
+#ifdef CAUSTICA_SPECTRAL
+          lambda = kLambdaMin + (kLambdaMax - kLambdaMin) * rand01(rng);
+          filt = channelSensitivity(lambda) * (kLambdaMax - kLambdaMin);
+#else
+          int c = min(int(rand01(rng) * 3.0), 2);
+          lambda = kChannelLambda[c];
+          filt = vec3(0.0);
+          filt[c] = 3.0;
+#endif
+        }
+        ior = cauchyIor(ior, m.absorption.w, lambda);
+      }
+#endif
+      float eta = front ? ior : 1.0 / ior;  // n_transmitted / n_incident
+      bool transmitted;
+      float u = rand01(rng);
+      float weight = sampleDielectric(dir, ns, eta, u, newDir, transmitted);
+      if (transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0)  // shading normal misled: use ng
+        weight = sampleDielectric(dir, ng, eta, u, newDir, transmitted);
+      beta *= weight;
+#ifdef CAUSTICA_VOLUME
+      if (transmitted) sigma = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
+#endif
+      prevDelta = true;
+    }
+#endif
+
+    // Russian roulette after a few bounces.
+    if (depth >= 3u) {
+      float q = min(maxComponent(beta), 1.0);
+      if (rand01(rng) >= q) break;
+      beta /= q;
+    }
+    dir = newDir;
+    org = offsetRayOrigin(p, dot(dir, ng) > 0.0 ? ng : -ng);
+  }
+  return radiance;
+}
+
+void main() {
+  uvec2 local = gl_GlobalInvocationID.xy;
+  uvec2 pixel = local + frame.tile.xy;
+  bool valid = all(lessThan(local, frame.tile.zw)) && all(lessThan(pixel, frame.frame.xy));
+  if (gl_LocalInvocationIndex == 0u) {
+    groupCounts[0] = 0u;
+    groupCounts[1] = 0u;
+    groupCounts[2] = 0u;
+    groupCounts[3] = 0u;
+  }
+  barrier();
+  uint primary = 0u, bad = 0u;
+  if (valid) {
+    vec3 sum = vec3(0.0);
+    uint spp = frame.options.y;
+    for (uint i = 0u; i < spp; ++i) {
+      uint rng = rngSeed(pixel.y * frame.frame.x + pixel.x, frame.frame.z + i, frame.frame.w);
+      vec3 l = tracePath(pixel, rng);
+      ++primary;
+      if (any(isnan(l)) || any(isinf(l))) ++bad;  // never added to the image; counted
+      else sum += l;
+    }
+    accumulate(ivec2(pixel), sum, float(spp));
+  }
+  atomicAdd(groupCounts[0], primary);
+  atomicAdd(groupCounts[1], gSecondaryRays);
+  atomicAdd(groupCounts[2], gShadowRays);
+  atomicAdd(groupCounts[3], bad);
+  barrier();
+  if (gl_LocalInvocationIndex == 0u) {
+    atomicAdd(counters.primaryRays, groupCounts[0]);
+    atomicAdd(counters.secondaryRays, groupCounts[1]);
+    atomicAdd(counters.shadowRays, groupCounts[2]);
+    atomicAdd(counters.nonFinite, groupCounts[3]);
+  }
+}

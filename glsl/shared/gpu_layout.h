@@ -1,0 +1,131 @@
+// gpu_layout.h — every struct and binding index shared by the host (C++) and the shaders (GLSL).
+// Compiled as C++ (with static_asserts on sizes) and included by GLSL, so layouts cannot drift.
+// All SSBO structs use std430 rules; every member is a vec4/uvec4 or a 4-byte scalar in a 16-byte group.
+#ifndef CAUSTICA_GPU_LAYOUT_H
+#define CAUSTICA_GPU_LAYOUT_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace caustica::gpu {
+using vec3 = glm::vec3;
+using vec4 = glm::vec4;
+using uvec4 = glm::uvec4;
+using uint = std::uint32_t;
+#define CAUSTICA_CONST static constexpr
+#else
+#define CAUSTICA_CONST const
+#endif
+
+// ---- binding indices (macros: GLSL 4.30 layout qualifiers take only literals) -------------------
+#define CAUSTICA_BINDING_NODES 0      // SSBO: BvhNode[]
+#define CAUSTICA_BINDING_TRIGEOM 1    // SSBO: TriGeom[] (reordered to BVH leaf order)
+#define CAUSTICA_BINDING_TRISHADE 2   // SSBO: TriShade[] (same order as TriGeom)
+#define CAUSTICA_BINDING_MATERIALS 3  // SSBO: Material[]
+#define CAUSTICA_BINDING_EMITTERS 4   // SSBO: Emitter[] (alias table over emissive triangles)
+#define CAUSTICA_BINDING_TEXELS 5     // SSBO: uint[] RGBA8 texels of all textures, sRGB-encoded
+#define CAUSTICA_BINDING_TEXINFO 6    // SSBO: TexInfo[]
+#define CAUSTICA_BINDING_COUNTERS 7   // SSBO: Counters (atomic statistics)
+#define CAUSTICA_SSBO_COUNT 8         // SSBO bindings used by the path tracer
+#define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
+#define CAUSTICA_IMAGE_ACCUM 0        // image unit: rgba32f running sum of radiance
+#define CAUSTICA_IMAGE_COMP 1         // image unit: rgba32f Kahan compensation of the sum
+#define CAUSTICA_IMAGE_DISPLAY 2      // image unit: rgba8 tone-mapped display image
+#define CAUSTICA_WORKGROUP_X 8        // compute work-group size in pixels
+#define CAUSTICA_WORKGROUP_Y 8
+#define CAUSTICA_BVH_STACK 64         // traversal stack entries; the builder guarantees depth < this
+
+CAUSTICA_CONST uint kInvalidIndex = 0xffffffffu;
+
+// Material flags (Material.flags)
+CAUSTICA_CONST uint kMatDoubleSided = 1u;
+CAUSTICA_CONST uint kMatHasVolume = 2u;      // Beer–Lambert absorption inside (KHR_materials_volume)
+CAUSTICA_CONST uint kMatDispersive = 4u;     // KHR_materials_dispersion with dispersion > 0
+
+// FrameParams.options.w flags
+CAUSTICA_CONST uint kFlagMis = 1u;           // next-event estimation + MIS (else pure BSDF sampling)
+CAUSTICA_CONST uint kFlagSpectral = 2u;      // hero-wavelength dispersion (else one RGB channel per path)
+
+// ---- SSBO structs ----------------------------------------------------------------------------
+// 32-byte BVH node: bounds and either two children (left, left+1) or a range of triangles.
+struct BvhNode {
+  vec3 bmin;        // world-space AABB minimum
+  uint leftFirst;   // inner node: index of the left child (right = left + 1); leaf: first triangle
+  vec3 bmax;        // world-space AABB maximum
+  uint triCount;    // 0 for an inner node, else the number of triangles in the leaf
+};
+
+// Triangle positions for intersection (48 bytes).
+struct TriGeom {
+  vec4 v0;  // xyz: vertex 0 (world space); w: material index (stored as float bits of a uint)
+  vec4 v1;  // xyz: vertex 1; w unused
+  vec4 v2;  // xyz: vertex 2; w unused
+};
+
+// Triangle shading attributes (64 bytes), fetched only for the closest hit.
+struct TriShade {
+  vec4 n0;  // xyz: vertex normal 0 (world space, unit); w: u of texcoord 0
+  vec4 n1;  // xyz: vertex normal 1; w: u of texcoord 1
+  vec4 n2;  // xyz: vertex normal 2; w: u of texcoord 2
+  vec4 vt;  // x,y,z: v of texcoords 0,1,2; w unused
+};
+
+// Material after the glTF material contract (docs/materials.md), 80 bytes.
+struct Material {
+  vec4 baseColor;     // rgb: linear base colour factor; a: opacity (1 = opaque)
+  vec4 emission;      // rgb: emitted radiance (linear, W sr^-1 m^-2 relative units); w: unused
+  vec4 params;        // x: metallic (mirror weight), y: roughness, z: transmission, w: ior at 587.6 nm
+  vec4 absorption;    // rgb: absorption coefficient sigma_a per scene unit (Beer–Lambert); w: abbe number V (0 = none)
+  uvec4 tex;          // x: base-colour texture index, y: emissive texture index (kInvalidIndex = none), z: flags, w unused
+};
+
+// One alias-table slot over emissive triangles (16 bytes).
+struct Emitter {
+  uint tri;         // triangle index (in TriGeom order)
+  float prob;       // probability of choosing this slot's own triangle when the slot is picked
+  uint alias;       // slot whose triangle is taken otherwise
+  float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
+};
+
+// A texture inside the texel SSBO (16 bytes).
+struct TexInfo {
+  uint offset;   // first texel in the texel SSBO
+  uint width;    // texels
+  uint height;   // texels
+  uint flags;    // bit 0: repeat S (else clamp), bit 1: repeat T, bit 2: mirrored S, bit 3: mirrored T, bit 4: nearest filter
+};
+
+// Statistics the shader writes atomically.
+struct Counters {
+  uint nonFinite;      // samples rejected because they were NaN or Inf
+  uint primaryRays;    // eye rays traced
+  uint secondaryRays;  // bounce rays traced
+  uint shadowRays;     // next-event-estimation visibility rays traced
+};
+
+// ---- UBO ---------------------------------------------------------------------------------------
+// Per-dispatch parameters (std140: vec4/uvec4 only).
+struct FrameParams {
+  vec4 camPos;      // xyz: eye position (world space)
+  vec4 camRight;    // xyz: right axis scaled by tan(yfov/2) * aspect
+  vec4 camUp;       // xyz: up axis scaled by tan(yfov/2)
+  vec4 camForward;  // xyz: unit viewing direction
+  uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
+  uvec4 options;    // x: max depth, y: samples per pixel in this dispatch, z: emitter count, w: kFlag* bits
+  uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
+  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); y: exposure (display); zw unused
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
+static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
+static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");
+static_assert(sizeof(Material) == 80, "Material must be 80 bytes (std430)");
+static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
+static_assert(sizeof(TexInfo) == 16, "TexInfo must be 16 bytes (std430)");
+static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
+static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
+}  // namespace caustica::gpu
+#endif
+#undef CAUSTICA_CONST
+#endif

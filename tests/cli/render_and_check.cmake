@@ -1,0 +1,20 @@
+# render_and_check.cmake — renders the default scene small with one backend and checks that the
+# program exits 0 and writes a non-empty image file (run with cmake -P; CLI, BACKEND, OUT given).
+file(REMOVE ${OUT})
+execute_process(COMMAND ${CLI} render --backend ${BACKEND} --size 32 --spp 2 -o ${OUT}
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "render --backend ${BACKEND} failed (${rc}): ${err}")
+endif()
+if(NOT EXISTS ${OUT})
+  message(FATAL_ERROR "render --backend ${BACKEND} wrote no ${OUT}")
+endif()
+file(SIZE ${OUT} size)
+if(size LESS 1000)
+  message(FATAL_ERROR "${OUT} is only ${size} bytes")
+endif()
+string(FIND "${err}" "OpenGL (${BACKEND})" found)
+if(found EQUAL -1)
+  message(FATAL_ERROR "render did not report the ${BACKEND} context: ${err}")
+endif()
+message(STATUS "${BACKEND}: ${err}")
