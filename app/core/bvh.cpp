@@ -113,15 +113,17 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     return bvh;
   }
 
-  std::vector<Prim> prims(n);
+  std::vector<Prim> prims;
+  prims.reserve(n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    Prim& p = prims[i];
+    Prim p;
     p.box = triangleBox(triangles[i]);
     p.index = i;
     for (int a = 0; a < 3; ++a) {  // halves first: no overflow; non-finite centroids (NaN/inf) -> 0
       const float c = 0.5f * p.box.min[a] + 0.5f * p.box.max[a];
       p.centroid[a] = std::isfinite(c) ? c : 0.0f;
     }
+    prims.push_back(p);
   }
 
   bvh.nodes.reserve(2 * std::size_t(n));
@@ -174,13 +176,11 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     double bestCost = std::numeric_limits<double>::infinity();
     std::uint32_t bestImbalance = ~0u;
     if (anyAxis) {
-      for (int a = 0; a < 3; ++a)
-        if (scale[a] > 0.0f)
-          for (int b = 0; b < bins; ++b) binsPerAxis[a][b] = Bin{};
+      // Flat axes have scale 0, so all their prims land in bin 0 and are ignored afterwards.
+      for (auto& axisBins : binsPerAxis) std::fill(axisBins.begin(), axisBins.begin() + bins, Bin{});
       for (std::uint32_t i = item.first; i < item.first + item.count; ++i) {
         const Prim& p = prims[i];
         for (int a = 0; a < 3; ++a) {
-          if (scale[a] <= 0.0f) continue;
           Bin& bin = binsPerAxis[a][binOf(p.centroid[a], cbox.min[a], scale[a], bins)];
           bin.box.grow(p.box);
           bin.count++;
@@ -188,30 +188,34 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
       }
       for (int a = 0; a < 3; ++a) {
         if (scale[a] <= 0.0f) continue;
-        const auto& bs = binsPerAxis[a];
-        double rightCost[kMaxBins];  // area * count of bins [i+1, bins)
+        // Sweep over the non-empty bins only (planes between empty bins give the same partitions).
+        int used[kMaxBins], m = 0;
+        for (int i = 0; i < bins; ++i)
+          if (binsPerAxis[a][i].count > 0) used[m++] = i;
+        double rightCost[kMaxBins];  // area * count of used bins [k, m)
         int rightCount[kMaxBins];
         Box acc;
         int cnt = 0;
-        for (int i = bins - 1; i > 0; --i) {
-          acc.grow(bs[i].box);
-          cnt += bs[i].count;
-          rightCost[i - 1] = acc.halfArea() * cnt;
-          rightCount[i - 1] = cnt;
+        for (int k = m - 1; k > 0; --k) {
+          const Bin& bin = binsPerAxis[a][used[k]];
+          acc.grow(bin.box);
+          cnt += bin.count;
+          rightCost[k] = acc.halfArea() * cnt;
+          rightCount[k] = cnt;
         }
         acc = Box{};
         cnt = 0;
-        for (int i = 0; i < bins - 1; ++i) {
-          acc.grow(bs[i].box);
-          cnt += bs[i].count;
-          if (cnt == 0 || rightCount[i] == 0) continue;
-          const double cost = acc.halfArea() * cnt + rightCost[i];
-          const std::uint32_t imbalance = std::uint32_t(std::abs(cnt - rightCount[i]));
+        for (int k = 0; k < m - 1; ++k) {
+          const Bin& bin = binsPerAxis[a][used[k]];
+          acc.grow(bin.box);
+          cnt += bin.count;
+          const double cost = acc.halfArea() * cnt + rightCost[k + 1];
+          const std::uint32_t imbalance = std::uint32_t(std::abs(cnt - rightCount[k + 1]));
           // Ties (e.g. flat boxes with zero area) go to the more balanced split.
           if (cost < bestCost || (cost == bestCost && imbalance < bestImbalance)) {
             bestCost = cost;
             bestAxis = a;
-            bestSplit = i + 1;
+            bestSplit = used[k + 1];  // left: bins < bestSplit
             bestImbalance = imbalance;
           }
         }
