@@ -25,6 +25,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
   vec3 org = frame.camPos.xyz;
   vec3 dir = eyeRayDirection(pixel, rand2(rng));
   vec3 beta = vec3(1.0);   // path throughput
+  float etaScale = 1.0;    // product of eta^2 over refractions: beta * etaScale is free of radiance scaling
   vec3 radiance = vec3(0.0);
   vec3 filt = vec3(1.0);   // per-channel weight of the wavelength(s) the path carries (dispersion)
   float lambda = 0.0;      // nm; 0 while the path still carries every wavelength
@@ -147,6 +148,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
       if (transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0)  // shading normal misled: use ng
         weight = sampleDielectric(dir, ng, eta, u, newDir, transmitted);
       beta *= weight;
+      if (transmitted) etaScale *= eta * eta;
 #ifdef CAUSTICA_VOLUME
       if (transmitted) sigma = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
 #endif
@@ -154,9 +156,10 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
     }
 #endif
 
-    // Russian roulette after a few bounces.
+    // Russian roulette after a few bounces, on the throughput without the eta^2 radiance scaling
+    // (inside glass that factor is not an energy loss and must not end paths; pbrt-v4 does the same).
     if (depth >= 3u) {
-      float q = min(maxComponent(beta), 1.0);
+      float q = min(maxComponent(beta) * etaScale, 1.0);
       if (rand01(rng) >= q) break;
       beta /= q;
     }

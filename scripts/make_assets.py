@@ -432,7 +432,7 @@ def write_json(path, doc):
 
 
 # ---- scenes ----------------------------------------------------------------------------------------
-CORNELL_CAMERA = dict(position=(0.0, 1.0, 3.9), yfov=0.6911)  # 39.6 degrees: the opening fills the view
+CORNELL_CAMERA = dict(position=(0.0, 1.0, 3.7), yfov=0.6911)  # 39.6 degrees: the opening fills the view
 
 
 def add_cornell_box(g, textured=False, wall_colors=None):
@@ -635,6 +635,8 @@ def bad_files():
         extensionsUsed=["EXT_caustica_unknown"], extensionsRequired=["EXT_caustica_unknown"])))
     put("lines-only.gltf", variant(lambda d: None, indices=(0, 1, 1, 2), mode=1))
     put("empty-scene.gltf", variant(lambda d: d["scenes"][0].update(nodes=[])))
+    put("degenerate-only.gltf", variant(lambda d: None, positions=[(0.0, 0.0, 0.0), (1.0, 0.0, 0.0),
+                                                                   (2.0, 0.0, 0.0)]))
     put("index-out-of-range.gltf", variant(lambda d: None, indices=(0, 1, 99)))
     put("accessor-overrun.gltf", variant(lambda d: None, extra_accessor_count=100))
     put("bufferview-overrun.gltf", variant(lambda d: d["bufferViews"][1].update(byteLength=4096)))

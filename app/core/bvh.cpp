@@ -4,7 +4,6 @@
 #include "bvh.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <string>
 
@@ -20,71 +19,117 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kMaxLeafDepth = CAUSTICA_BVH_STACK - 1;
 constexpr int kMaxBins = 64;
 
-// Axis-aligned box; an empty box has min = +inf, max = -inf (neutral for grow()).
+// 4-wide float vector (GCC/Clang vector extension, compiled to SSE/NEON): lanes x, y, z, unused.
+typedef float F4 __attribute__((vector_size(16)));
+typedef std::int32_t I4 __attribute__((vector_size(16)));
+inline F4 splat(float x) { return F4{x, x, x, x}; }
+inline F4 vmin(F4 a, F4 b) { return a < b ? a : b; }
+inline F4 vmax(F4 a, F4 b) { return a > b ? a : b; }
+
+// Axis-aligned box in world space. An empty box has lo = +inf, hi = -inf, which grow() treats as neutral.
 struct Box {
-  glm::vec3 min{kInf};
-  glm::vec3 max{-kInf};
+  F4 lo = splat(kInf);
+  F4 hi = splat(-kInf);
   void grow(const Box& b) {
-    min = glm::min(min, b.min);
-    max = glm::max(max, b.max);
+    lo = vmin(lo, b.lo);
+    hi = vmax(hi, b.hi);
   }
-  // Half the surface area in double precision (no overflow for huge coordinates); 0 when empty.
+  void grow(F4 p) {
+    lo = vmin(lo, p);
+    hi = vmax(hi, p);
+  }
+  // Half the surface area, in double so that huge coordinates cannot overflow. Box must not be empty.
   double halfArea() const {
-    if (!(min.x <= max.x && min.y <= max.y && min.z <= max.z)) return 0.0;
-    const double dx = double(max.x) - min.x, dy = double(max.y) - min.y, dz = double(max.z) - min.z;
+    const double dx = double(hi[0]) - lo[0], dy = double(hi[1]) - lo[1], dz = double(hi[2]) - lo[2];
     return dx * dy + dy * dz + dz * dx;
   }
 };
 
-// Build-time primitive: bounds, sanitised centroid and index of the input triangle (40 bytes).
+// Build-time primitive (32 bytes): the finite bounds of one input triangle in lanes 0-2; its index
+// split into two 16-bit halves stored as exact small floats in the 4th lanes (never used as geometry).
 struct Prim {
   Box box;
-  glm::vec3 centroid;
-  std::uint32_t index;
+  Prim(const Box& b, std::uint32_t index) : box(b) {
+    box.lo[3] = float(index & 0xffffu);
+    box.hi[3] = float(index >> 16);
+  }
+  std::uint32_t index() const { return std::uint32_t(box.lo[3]) | std::uint32_t(box.hi[3]) << 16; }
 };
+
+// Centroid of a prim's box (halves first, so no overflow near FLT_MAX).
+inline F4 centroidOf(const Prim& p) { return splat(0.5f) * p.box.lo + splat(0.5f) * p.box.hi; }
+
+// Bins of a centroid on all axes: floor((c - cmin) * scale) clamped to [0, bins - 1]. A NaN from a
+// flat or overflowing axis (scale 0) becomes bin 0, and so does the 4th lane (scale 0 there too).
+// Binning and partitioning both use this function.
+inline I4 binsOf(F4 c, F4 cmin, F4 scale, F4 lastBin) {
+  return __builtin_convertvector(vmin(vmax((c - cmin) * scale, splat(0.0f)), lastBin), I4);
+}
 
 struct Bin {
   Box box;
   int count = 0;
 };
 
-// A node still to be built: its slot in the node array, its range of prims, its level and bounds.
+// Best split found so far: axis, position (first bin of the right child), cost
+// (area * count summed over both children) and |left - right| counts for breaking ties.
+struct Split {
+  int axis = -1;
+  int pos = 0;
+  double cost = std::numeric_limits<double>::infinity();
+  std::uint32_t imbalance = ~0u;
+  void consider(int a, int p, double c, int countLeft, int countRight) {
+    const std::uint32_t imb = std::uint32_t(std::abs(countLeft - countRight));
+    if (c < cost || (c == cost && imb < imbalance)) {  // ties (e.g. zero areas) go to the balanced split
+      axis = a;
+      pos = p;
+      cost = c;
+      imbalance = imb;
+    }
+  }
+  bool found() const { return axis >= 0 && std::isfinite(cost); }
+};
+
+// A node still to be built: its slot in the node array, its range of prims, its level, the bounds
+// of its prims and the bounds of their centroids.
 struct WorkItem {
   std::uint32_t node;
   std::uint32_t first;
   std::uint32_t count;
   int depth;
   Box box;
+  Box cbox;
 };
 
 // Levels that a median-split subtree over n prims needs below its root: ceil(log2(ceil(n / leaf))).
 int medianLevels(std::uint64_t n, std::uint64_t leaf) {
-  std::uint64_t leaves = (n + leaf - 1) / leaf;
+  const std::uint64_t leaves = (n + leaf - 1) / leaf;
   int levels = 0;
   while ((std::uint64_t(1) << levels) < leaves) ++levels;
   return levels;
 }
 
-// Bin of a centroid coordinate; identical arithmetic in binning and partitioning keeps them consistent.
-inline int binOf(float c, float cmin, float scale, int bins) {
-  const float f = (c - cmin) * scale;
-  return f > 0.0f ? int(std::min(f, float(bins - 1))) : 0;
+// Bounds and centroid bounds of prims [first, first + count).
+void boundsOfRange(const std::vector<Prim>& prims, std::uint32_t first, std::uint32_t count, Box& box, Box& cbox) {
+  box = Box{};
+  cbox = Box{};
+  for (std::uint32_t i = first; i < first + count; ++i) {
+    box.grow(prims[i].box);
+    cbox.grow(centroidOf(prims[i]));
+  }
 }
 
-Box boxOfRange(const std::vector<Prim>& prims, std::uint32_t first, std::uint32_t count) {
-  Box b;
-  for (std::uint32_t i = first; i < first + count; ++i) b.grow(prims[i].box);
-  return b;
-}
-
-// Box of one triangle ignoring NaN coordinates (a triangle with NaN never hits, so any box is safe).
+// Finite box of one triangle. A triangle with a NaN or infinite coordinate never hits, so it is
+// binned as a point at the origin; this keeps every bound and centroid finite.
 Box triangleBox(const Triangle& tri) {
   Box b;
-  for (const glm::vec3& p : tri.p)
-    for (int a = 0; a < 3; ++a) {
-      b.min[a] = std::fmin(b.min[a], p[a]);
-      b.max[a] = std::fmax(b.max[a], p[a]);
+  for (const glm::vec3& p : tri.p) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      b.lo = b.hi = splat(0.0f);
+      return b;
     }
+    b.grow(F4{p.x, p.y, p.z, 0.0f});
+  }
   return b;
 }
 
@@ -115,79 +160,69 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
 
   std::vector<Prim> prims;
   prims.reserve(n);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    Prim p;
-    p.box = triangleBox(triangles[i]);
-    p.index = i;
-    for (int a = 0; a < 3; ++a) {  // halves first: no overflow; non-finite centroids (NaN/inf) -> 0
-      const float c = 0.5f * p.box.min[a] + 0.5f * p.box.max[a];
-      p.centroid[a] = std::isfinite(c) ? c : 0.0f;
-    }
-    prims.push_back(p);
-  }
+  for (std::uint32_t i = 0; i < n; ++i) prims.emplace_back(triangleBox(triangles[i]), i);
 
   bvh.nodes.reserve(2 * std::size_t(n));
   bvh.nodes.emplace_back();
   std::vector<WorkItem> work;
-  work.push_back({0, 0, n, 1, boxOfRange(prims, 0, n)});
+  work.push_back({0, 0, n, 1, Box{}, Box{}});
+  boundsOfRange(prims, 0, n, work.back().box, work.back().cbox);
   const double rootArea = work.back().box.halfArea();
   const bool rootAreaOk = rootArea > 0.0 && std::isfinite(rootArea);
-  double sah = 0.0;
+  double sah = 0.0;  // SAH cost relative to the root's area
 
-  std::array<std::array<Bin, kMaxBins>, 3> binsPerAxis;
+  Bin binsPerAxis[3][kMaxBins];  // kept empty between nodes
+  const F4 lastBin = splat(float(bins - 1));
   while (!work.empty()) {
     const WorkItem item = work.back();
     work.pop_back();
-    const double area = rootAreaOk ? item.box.halfArea() / rootArea : 1.0;
+    const double nodeArea = item.box.halfArea();
+    const double relArea = rootAreaOk ? nodeArea / rootArea : 1.0;
     gpu::BvhNode& out = bvh.nodes[item.node];
-    out.bmin = item.box.min;
-    out.bmax = item.box.max;
+    out.bmin = glm::vec3(item.box.lo[0], item.box.lo[1], item.box.lo[2]);
+    out.bmax = glm::vec3(item.box.hi[0], item.box.hi[1], item.box.hi[2]);
 
     auto makeLeaf = [&]() {
+      if (item.count > maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
       gpu::BvhNode& leaf = bvh.nodes[item.node];
       leaf.leftFirst = item.first;
       leaf.triCount = item.count;
       bvh.leafCount++;
       bvh.depth = std::max(bvh.depth, item.depth);
-      sah += ci * double(item.count) * area;
+      sah += ci * double(item.count) * relArea;
     };
     if (item.count == 1 || item.depth >= kMaxLeafDepth) {
-      if (item.count > maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
       makeLeaf();
       continue;
     }
 
-    // Centroid bounds decide which axes can be binned.
-    Box cbox;
-    for (std::uint32_t i = item.first; i < item.first + item.count; ++i) {
-      cbox.min = glm::min(cbox.min, prims[i].centroid);
-      cbox.max = glm::max(cbox.max, prims[i].centroid);
-    }
-    float scale[3];
+    // Axes with a usable centroid extent get binned; flat (or overflowing) axes get scale 0.
+    F4 scale = splat(0.0f);
     bool anyAxis = false;
     for (int a = 0; a < 3; ++a) {
-      const float s = float(bins) / (cbox.max[a] - cbox.min[a]);
-      scale[a] = (s > 0.0f && std::isfinite(s)) ? s : 0.0f;  // 0: axis is flat (or overflowing)
+      const float s = float(bins) / (item.cbox.hi[a] - item.cbox.lo[a]);
+      scale[a] = (s > 0.0f && std::isfinite(s)) ? s : 0.0f;
       anyAxis |= scale[a] > 0.0f;
     }
 
-    // Binned SAH: find the cheapest plane over all axes. Costs are multiplied by the node's area.
-    int bestAxis = -1, bestSplit = 0;
-    double bestCost = std::numeric_limits<double>::infinity();
-    std::uint32_t bestImbalance = ~0u;
+    // Binned SAH over the axes with a centroid extent; pos = first bin of the right child. Costs are
+    // in units of area * count (the node's own terms are constant).
+    Split best;
     if (anyAxis) {
-      // Flat axes have scale 0, so all their prims land in bin 0 and are ignored afterwards.
-      for (auto& axisBins : binsPerAxis) std::fill(axisBins.begin(), axisBins.begin() + bins, Bin{});
       for (std::uint32_t i = item.first; i < item.first + item.count; ++i) {
         const Prim& p = prims[i];
-        for (int a = 0; a < 3; ++a) {
-          Bin& bin = binsPerAxis[a][binOf(p.centroid[a], cbox.min[a], scale[a], bins)];
+        const I4 b = binsOf(centroidOf(p), item.cbox.lo, scale, lastBin);
+        for (int a = 0; a < 3; ++a) {  // flat axes all land in bin 0 and are ignored below
+          Bin& bin = binsPerAxis[a][b[a]];
           bin.box.grow(p.box);
           bin.count++;
         }
       }
       for (int a = 0; a < 3; ++a) {
-        if (scale[a] <= 0.0f) continue;
+        if (scale[a] <= 0.0f) {
+          binsPerAxis[a][0] = Bin{};
+          continue;
+        }
         // Sweep over the non-empty bins only (planes between empty bins give the same partitions).
         int used[kMaxBins], m = 0;
         for (int i = 0; i < bins; ++i)
@@ -205,78 +240,79 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
         }
         acc = Box{};
         cnt = 0;
-        for (int k = 0; k < m - 1; ++k) {
-          const Bin& bin = binsPerAxis[a][used[k]];
+        for (int k = 1; k < m; ++k) {
+          const Bin& bin = binsPerAxis[a][used[k - 1]];
           acc.grow(bin.box);
           cnt += bin.count;
-          const double cost = acc.halfArea() * cnt + rightCost[k + 1];
-          const std::uint32_t imbalance = std::uint32_t(std::abs(cnt - rightCount[k + 1]));
-          // Ties (e.g. flat boxes with zero area) go to the more balanced split.
-          if (cost < bestCost || (cost == bestCost && imbalance < bestImbalance)) {
-            bestCost = cost;
-            bestAxis = a;
-            bestSplit = used[k + 1];  // left: bins < bestSplit
-            bestImbalance = imbalance;
-          }
+          best.consider(a, used[k], acc.halfArea() * cnt + rightCost[k], cnt, rightCount[k]);
         }
+        for (int k = 0; k < m; ++k) binsPerAxis[a][used[k]] = Bin{};  // all bins empty again
       }
     }
 
-    const double nodeArea = item.box.halfArea();
-    const bool sahFound = bestAxis >= 0 && std::isfinite(bestCost);
     if (item.count <= maxLeaf) {
-      // Small enough for a leaf: split only if SAH says it pays (and depth allows, checked above).
-      const bool split = sahFound && ct * nodeArea + ci * bestCost < ci * double(item.count) * nodeArea;
+      // Small enough for a leaf: split only if SAH says it pays.
+      const bool split = best.found() && ct * nodeArea + ci * best.cost < ci * double(item.count) * nodeArea;
       if (!split) {
         makeLeaf();
         continue;
       }
     }
 
-    // Split: SAH plane unless the depth budget requires a median split (which keeps
+    // Split at the SAH plane unless the depth budget requires a median split (which keeps
     // depth + medianLevels(count) constant, so leaves never pass kMaxLeafDepth).
     const bool forceMedian = item.depth + medianLevels(item.count, maxLeaf) >= kMaxLeafDepth;
-    std::uint32_t leftCount = 0;
-    Box leftBox, rightBox;
-    if (sahFound && !forceMedian) {
-      const int a = bestAxis;
-      const float cmin = cbox.min[a], s = scale[a];
-      Prim* begin = prims.data() + item.first;
-      Prim* mid = std::partition(begin, begin + item.count, [&](const Prim& p) {
-        return binOf(p.centroid[a], cmin, s, bins) < bestSplit;
-      });
-      leftCount = std::uint32_t(mid - begin);
-      for (int i = 0; i < bins; ++i) (i < bestSplit ? leftBox : rightBox).grow(binsPerAxis[a][i].box);
+    WorkItem left{0, item.first, 0, item.depth + 1, Box{}, Box{}};
+    WorkItem right{0, 0, 0, item.depth + 1, Box{}, Box{}};
+    if (best.found() && !forceMedian) {
+      // In-place partition; child bounds come from the prims themselves, so they are exact.
+      std::uint32_t i = item.first, j = item.first + item.count;
+      while (i < j) {
+        const F4 c = centroidOf(prims[i]);
+        if (binsOf(c, item.cbox.lo, scale, lastBin)[best.axis] < best.pos) {
+          left.box.grow(prims[i].box);
+          left.cbox.grow(c);
+          ++i;
+        } else {
+          --j;
+          std::swap(prims[i], prims[j]);
+          right.box.grow(prims[j].box);
+          right.cbox.grow(c);
+        }
+      }
+      left.count = i - item.first;
     }
-    if (leftCount == 0 || leftCount == item.count) {
+    if (left.count == 0 || left.count == item.count) {
       // Median split along the widest centroid axis (any order when all centroids coincide).
       int a = 0;
-      const glm::vec3 ext = cbox.max - cbox.min;
-      if (ext.y > ext[a]) a = 1;
-      if (ext.z > ext[a]) a = 2;
-      leftCount = item.count / 2;
+      for (int k = 1; k < 3; ++k)
+        if (item.cbox.hi[k] - item.cbox.lo[k] > item.cbox.hi[a] - item.cbox.lo[a]) a = k;
+      left.count = item.count / 2;
       Prim* begin = prims.data() + item.first;
-      std::nth_element(begin, begin + leftCount, begin + item.count,
-                       [a](const Prim& p, const Prim& q) { return p.centroid[a] < q.centroid[a]; });
-      leftBox = boxOfRange(prims, item.first, leftCount);
-      rightBox = boxOfRange(prims, item.first + leftCount, item.count - leftCount);
+      std::nth_element(begin, begin + left.count, begin + item.count,
+                       [a](const Prim& p, const Prim& q) { return centroidOf(p)[a] < centroidOf(q)[a]; });
+      boundsOfRange(prims, item.first, left.count, left.box, left.cbox);
+      boundsOfRange(prims, item.first + left.count, item.count - left.count, right.box, right.cbox);
     }
+    right.first = item.first + left.count;
+    right.count = item.count - left.count;
 
-    const std::uint32_t left = std::uint32_t(bvh.nodes.size());
-    bvh.nodes[item.node].leftFirst = left;
+    left.node = std::uint32_t(bvh.nodes.size());
+    right.node = left.node + 1;
+    bvh.nodes[item.node].leftFirst = left.node;
     bvh.nodes[item.node].triCount = 0;
     bvh.nodes.emplace_back();
     bvh.nodes.emplace_back();
-    sah += ct * area;
-    work.push_back({left + 1, item.first + leftCount, item.count - leftCount, item.depth + 1, rightBox});
-    work.push_back({left, item.first, leftCount, item.depth + 1, leftBox});
+    sah += ct * relArea;
+    work.push_back(right);
+    work.push_back(left);
   }
 
   if (bvh.depth >= CAUSTICA_BVH_STACK)
     throw Error("bvh.cpp: BVH depth " + std::to_string(bvh.depth) + " exceeds the traversal stack");
   bvh.sahCost = float(sah);
   bvh.order.resize(n);
-  for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index;
+  for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
   return bvh;
 }
 

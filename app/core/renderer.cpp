@@ -173,23 +173,29 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   fp.camRight = glm::vec4(right * tanHalf * aspect, 0.0f);
   fp.camUp = glm::vec4(up * tanHalf, 0.0f);
   fp.camForward = glm::vec4(fwd, 0.0f);
-  fp.frame = glm::uvec4(w, h, sampleBase_, settings_.seed);
-  fp.options = glm::uvec4(settings_.maxDepth, spp, gpuScene_.emitters.size(),
-                          (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
-                              (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
   fp.tile = glm::uvec4(0, y0, w, y1 - y0);
   fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 1.0f, 0.0f, 0.0f);
-  frameUbo_.update(0, sizeof fp, &fp);
 
   prog.use();
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
   frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
-  glDispatchCompute((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
-                    (y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
-  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
-                  GL_TEXTURE_UPDATE_BARRIER_BIT);
+  // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested
+  // loops together (65535 from the outermost loop's start) and silently stops beyond; a per-sample
+  // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
+  // depend on how samples are split.
+  for (int s = 0; s < spp; ++s) {
+    fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
+    fp.options = glm::uvec4(settings_.maxDepth, 1u, gpuScene_.emitters.size(),
+                            (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
+                                (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
+    frameUbo_.update(0, sizeof fp, &fp);
+    glDispatchCompute((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
+                      (y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+  }
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   checkGlError("path tracing dispatch");
   readCounters();
 }

@@ -141,21 +141,24 @@ bool rangeFits(std::uint64_t offset, std::uint64_t stride, std::uint64_t count, 
 // byte ranges; this pass rejects such files with a message naming the property.
 class JsonChecker {
  public:
-  explicit JsonChecker(const std::string& path) : path_(path) {}
+  // baseDir: folder of external files; binary: the document is a GLB's JSON chunk.
+  JsonChecker(const std::string& path, const std::string& baseDir, bool binary)
+      : path_(path), baseDir_(baseDir), binary_(binary) {}
 
   void check(const Json& root) {
     if (!root.is_object()) fail("the top-level JSON value is " + describe(root) + ", not an object");
     checkAsset(root);
     checkExtensionLists(root);
+    // Shapes of the top-level arrays first: the checks below look across them.
+    for (const char* key : {"scenes", "nodes", "meshes", "accessors", "bufferViews", "buffers", "images", "samplers",
+                            "textures", "materials", "cameras", "skins", "animations"})
+      forEach(root, key, [](const Json&, const std::string&) {});
     index(root, "", "scene");
     forEach(root, "scenes", [&](const Json& o, const std::string& at) { indexArray(o, at, "nodes"); });
     forEach(root, "nodes", [&](const Json& o, const std::string& at) { checkNode(o, at); });
-    forEach(root, "meshes", [&](const Json& o, const std::string& at) { checkMesh(o, at); });
-    forEach(root, "accessors", [&](const Json& o, const std::string& at) { checkAccessor(o, at); });
-    forEach(root, "buffers", [&](const Json& o, const std::string& at) {
-      index(o, at, "byteLength", true, kMaxByteCount);
-      string(o, at, "uri");
-    });
+    forEach(root, "meshes", [&](const Json& o, const std::string& at) { checkMesh(root, o, at); });
+    forEach(root, "accessors", [&](const Json& o, const std::string& at) { checkAccessor(root, o, at); });
+    forEach(root, "buffers", [&](const Json& o, const std::string& at) { checkBuffer(o, at); });
     forEach(root, "bufferViews", [&](const Json& o, const std::string& at) { checkBufferView(root, o, at); });
     forEach(root, "images", [&](const Json& o, const std::string& at) { checkImage(root, o, at); });
     forEach(root, "samplers", [&](const Json& o, const std::string& at) {
@@ -210,7 +213,8 @@ class JsonChecker {
   void checkIndexValue(const Json& v, const std::string& where, std::uint64_t max) const {
     bool ok = v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0);
     expect(ok, v, where, "a non-negative integer");
-    if (v.get<std::uint64_t>() > max) fail(where + " is " + str(v.get<std::uint64_t>()) + ", too large (limit " + str(max) + ")");
+    if (v.get<std::uint64_t>() > max)
+      fail(where + " is " + str(v.get<std::uint64_t>()) + ", too large (limit " + str(max) + ")");
   }
 
   const Json* index(const Json& obj, const std::string& at, const char* key, bool required = false,
@@ -328,42 +332,122 @@ class JsonChecker {
     string(o, at, "name");
   }
 
-  void checkMesh(const Json& o, const std::string& at) const {
+  static std::size_t arraySize(const Json& root, const char* key) {
+    const Json* v = find(root, key);
+    return v ? v->size() : 0;
+  }
+
+  // An index property that must also refer to an existing element of the top-level array `target`.
+  const Json* reference(const Json& root, const Json& obj, const std::string& at, const char* key,
+                        const char* target, bool required = false) const {
+    const Json* v = index(obj, at, key, required);
+    if (v) checkReference(root, *v, join(at, key), target);
+    return v;
+  }
+
+  void checkReference(const Json& root, const Json& v, const std::string& where, const char* target) const {
+    const std::size_t count = arraySize(root, target);
+    if (v.get<std::uint64_t>() >= count)
+      fail(where + " is " + str(v.get<std::uint64_t>()) + ", but the file has " + str(count) + " " + target);
+  }
+
+  void checkMesh(const Json& root, const Json& o, const std::string& at) const {
     const Json* prims = array(o, at, "primitives", true);
     for (std::size_t i = 0; i < prims->size(); ++i) {
       const Json& p = (*prims)[i];
       const std::string pat = join(at, "primitives") + "[" + str(i) + "]";
       expect(p.is_object(), p, pat, "an object");
       const Json* attributes = object(p, pat, "attributes", true);
-      for (const auto& item : attributes->items())
-        checkIndexValue(item.value(), join(pat, "attributes") + "." + oneLine(item.key()), kMaxIndex);
-      index(p, pat, "indices");
+      for (const auto& item : attributes->items()) {
+        const std::string where = join(pat, "attributes") + "." + oneLine(item.key());
+        checkIndexValue(item.value(), where, kMaxIndex);
+        checkReference(root, item.value(), where, "accessors");
+      }
+      if (const Json* indices = reference(root, p, pat, "indices", "accessors")) {
+        const Json& accessor = (*find(root, "accessors"))[indices->get<std::size_t>()];
+        if (accessor.is_object() && !accessor.contains("bufferView"))
+          fail(join(pat, "indices") + ": accessors[" + str(indices->get<std::uint64_t>()) +
+               "] has no bufferView (index data must be stored)");
+      }
       index(p, pat, "material");
       index(p, pat, "mode");
       array(p, pat, "targets");
     }
   }
 
-  void checkAccessor(const Json& o, const std::string& at) const {
-    index(o, at, "bufferView");
+  void checkAccessor(const Json& root, const Json& o, const std::string& at) const {
+    reference(root, o, at, "bufferView", "bufferViews");
     index(o, at, "byteOffset", false, kMaxByteCount);
-    index(o, at, "componentType", true);
+    const auto componentType = index(o, at, "componentType", true)->get<std::uint64_t>();
+    if (componentType < 5120 || componentType > 5126 || componentType == 5124)
+      fail(join(at, "componentType") + " is " + str(componentType) +
+           "; it must be 5120 (BYTE), 5121, 5122, 5123, 5125 or 5126 (FLOAT)");
     boolean(o, at, "normalized");
     index(o, at, "count", true, kMaxByteCount);
-    string(o, at, "type", true);
+    const std::string type = string(o, at, "type", true)->get<std::string>();
+    static const char* const kTypes[] = {"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"};
+    if (std::none_of(std::begin(kTypes), std::end(kTypes), [&](const char* t) { return type == t; }))
+      fail(join(at, "type") + " is \"" + oneLine(type) + "\"; it must be SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4");
     numbers(o, at, "min", 0);
     numbers(o, at, "max", 0);
     if (const Json* sparse = object(o, at, "sparse")) {
       const std::string sat = join(at, "sparse");
       index(*sparse, sat, "count", true);
       const Json* indices = object(*sparse, sat, "indices", true);
-      index(*indices, join(sat, "indices"), "bufferView", true);
+      reference(root, *indices, join(sat, "indices"), "bufferView", "bufferViews", true);
       index(*indices, join(sat, "indices"), "byteOffset");
       index(*indices, join(sat, "indices"), "componentType", true);
       const Json* values = object(*sparse, sat, "values", true);
-      index(*values, join(sat, "values"), "bufferView", true);
+      reference(root, *values, join(sat, "values"), "bufferView", "bufferViews", true);
       index(*values, join(sat, "values"), "byteOffset");
     }
+  }
+
+  // Buffer sources are checked here so that the messages name the buffer (tinygltf's do not).
+  void checkBuffer(const Json& o, const std::string& at) const {
+    const auto length = index(o, at, "byteLength", true, kMaxByteCount)->get<std::uint64_t>();
+    const Json* uriValue = string(o, at, "uri");
+    if (!uriValue) {
+      if (!binary_) fail(join(at, "uri") + " is missing (only a .glb file's buffer may omit it)");
+      return;
+    }
+    const std::string uri = uriValue->get<std::string>();
+    if (uri.rfind("data:", 0) == 0) {
+      const auto comma = uri.find(";base64,");
+      if (comma == std::string::npos) fail(join(at, "uri") + " is a data URI without base64 content");
+      std::size_t chars = uri.size() - comma - 8;
+      const char* payload = uri.c_str() + comma + 8;
+      while (chars > 0 && payload[chars - 1] == '=') --chars;
+      for (std::size_t i = 0; i < chars; ++i)
+        if (!std::isalnum(static_cast<unsigned char>(payload[i])) && payload[i] != '+' && payload[i] != '/')
+          fail(join(at, "uri") + " holds invalid base64 data (character " + str(i) + ")");
+      const std::uint64_t decoded = chars / 4 * 3 + (chars % 4 == 0 ? 0 : chars % 4 - 1);
+      if (decoded != length)
+        fail(at + ": the data URI holds " + str(decoded) + " bytes but byteLength is " + str(length));
+      return;
+    }
+    const std::filesystem::path file = std::filesystem::path(baseDir_) / uriDecode(uri);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+      fail(join(at, "uri") + " '" + oneLine(uri) + "': file not found (" + oneLine(file.string()) + ")");
+    const std::uint64_t size = std::filesystem::file_size(file, ec);
+    if (!ec && size != length)
+      fail(at + " '" + oneLine(uri) + "' is " + str(size) + " bytes, but byteLength is " + str(length));
+  }
+
+  // Percent-decoding of a relative URI (glTF URIs are RFC 3986).
+  static std::string uriDecode(const std::string& uri) {
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+      if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+          std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+        out += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+        i += 2;
+      } else {
+        out += uri[i];
+      }
+    }
+    return out;
   }
 
   // Byte ranges of buffer views are checked here because tinygltf reads embedded images through
@@ -386,6 +470,7 @@ class JsonChecker {
   }
 
   void checkImage(const Json& root, const Json& o, const std::string& at) const {
+    if (!o.contains("uri") && !o.contains("bufferView")) fail(at + " has neither a uri nor a bufferView");
     string(o, at, "uri");
     string(o, at, "mimeType");
     if (const Json* view = index(o, at, "bufferView")) {
@@ -447,7 +532,10 @@ class JsonChecker {
   }
 
   void checkCamera(const Json& o, const std::string& at) const {
-    string(o, at, "type", true);
+    const std::string type = string(o, at, "type", true)->get<std::string>();
+    if (type != "perspective" && type != "orthographic")
+      fail(join(at, "type") + " is \"" + oneLine(type) + "\"; it must be perspective or orthographic");
+    object(o, at, type.c_str(), true);
     string(o, at, "name");
     if (const Json* p = object(o, at, "perspective")) {
       const std::string pat = join(at, "perspective");
@@ -464,6 +552,8 @@ class JsonChecker {
   }
 
   std::string path_;
+  std::string baseDir_;
+  bool binary_;
 };
 
 // ---- file reading --------------------------------------------------------------------------------
@@ -483,6 +573,30 @@ std::vector<unsigned char> readFile(const std::string& path) {
   }
   if (in.bad()) throw Error(path + ": read error: " + std::strerror(errno));
   return bytes;
+}
+
+// File access for tinygltf (external buffers and images): regular files only, read with the same
+// checks as the scene file itself (tinygltf's default reader trusts the size a directory reports).
+bool fsFileExists(const std::string& path, void*) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+std::string fsExpandFilePath(const std::string& path, void*) { return path; }
+
+bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+  try {
+    *out = readFile(path);
+    return true;
+  } catch (const std::exception& e) {
+    if (err) *err += std::string(e.what()) + "\n";
+    return false;
+  }
+}
+
+bool fsWriteWholeFile(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing files is disabled\n";
+  return false;
 }
 
 std::uint32_t readU32(const unsigned char* p) {
@@ -507,7 +621,8 @@ std::string glbJson(const std::string& path, const std::vector<unsigned char>& b
   if (binAt + 8 <= length) {
     const std::uint64_t binLength = readU32(&bytes[binAt]);
     if (binAt + 8 + binLength > length)
-      fail("the BIN chunk (" + str(binLength) + " bytes) overruns the file (" + str(length - binAt - 8) + " bytes left)");
+      fail("the BIN chunk (" + str(binLength) + " bytes) overruns the file (" + str(length - binAt - 8) +
+           " bytes left)");
   } else if (binAt != length) {
     fail("there are " + str(length - binAt) + " stray bytes after the JSON chunk");
   }
@@ -572,7 +687,8 @@ const char* componentName(int type) {
 
 std::string formatName(int componentType, bool normalized) {
   const char* name = componentName(componentType);
-  return std::string(normalized ? "normalized " : "") + (name ? name : "invalid (" + std::to_string(componentType) + ")");
+  return std::string(normalized ? "normalized " : "") +
+         (name ? name : "invalid (" + std::to_string(componentType) + ")");
 }
 
 const char* typeName(int type) {
@@ -657,8 +773,12 @@ class SceneBuilder {
     if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
     if (badNormals_ > 0)
       warn(str(badNormals_) + " triangle(s) had zero or non-finite vertex normals; flat normals used for them");
-    if (scene_.triangles.empty())
-      fail("the scene has no triangles to render" + (firstSkip_.empty() ? std::string() : " (" + firstSkip_ + ")"));
+    if (scene_.triangles.empty()) {
+      std::string why = firstSkip_;
+      if (why.empty() && degenerate_ > 0) why = "all " + str(degenerate_) + " triangles have zero area";
+      if (why.empty()) why = "the default scene's nodes reference no mesh triangles";
+      fail("the scene has no triangles to render (" + why + ")");
+    }
     for (const Triangle& t : scene_.triangles)
       for (const glm::vec3& p : t.p) scene_.bounds.grow(p);
   }
@@ -1006,8 +1126,8 @@ class SceneBuilder {
            " buffers");
     const tinygltf::Buffer& buffer = model_.buffers[std::size_t(view.buffer)];
     if (!rangeFits(view.byteOffset, 0, 1, view.byteLength, buffer.data.size()))
-      fail(vat + " (byteOffset " + str(view.byteOffset) + ", byteLength " + str(view.byteLength) + ") overruns buffers[" +
-           str(std::uint64_t(view.buffer)) + "] (" + str(buffer.data.size()) + " bytes)");
+      fail(vat + " (byteOffset " + str(view.byteOffset) + ", byteLength " + str(view.byteLength) +
+           ") overruns buffers[" + str(std::uint64_t(view.buffer)) + "] (" + str(buffer.data.size()) + " bytes)");
     return {buffer.data.data() + view.byteOffset, view.byteLength, view.byteStride};
   }
 
@@ -1197,7 +1317,8 @@ class SceneBuilder {
     std::size_t triangles = 0;
     if (prim.mode == TINYGLTF_MODE_TRIANGLES) {
       triangles = n / 3;
-      if (n % 3 != 0) warn(at + ": " + str(n) + " indices are not a multiple of 3; the last " + str(n % 3) + " ignored");
+      if (n % 3 != 0)
+        warn(at + ": " + str(n) + " indices are not a multiple of 3; the last " + str(n % 3) + " are ignored");
     } else if (n >= 3) {
       triangles = n - 2;
     }
@@ -1288,15 +1409,20 @@ Scene loadScene(const std::string& path) {
     if (what.rfind("[json.exception.", 0) == 0 && bracket != std::string::npos) what = what.substr(bracket + 2);
     throw Error(path + ": invalid JSON: " + oneLine(what));
   }
-  JsonChecker(path).check(document);
+  const std::string baseDir = std::filesystem::path(path).parent_path().string();
+  try {
+    JsonChecker(path, baseDir, binary).check(document);
+  } catch (const Json::exception& e) {  // a check that assumed a JSON type it had not verified
+    throw Error(path + ": unexpected JSON structure: " + oneLine(e.what()));
+  }
 
   tinygltf::Model model;
   ImageLog imageLog;
   try {
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(decodeImage, &imageLog);
+    loader.SetFsCallbacks({fsFileExists, fsExpandFilePath, fsReadWholeFile, fsWriteWholeFile, nullptr});
     std::string err, warn;
-    const std::string baseDir = std::filesystem::path(path).parent_path().string();
     const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                                          static_cast<unsigned int>(bytes.size()), baseDir)
                            : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(),

@@ -40,12 +40,9 @@ struct Expander {
   const ShaderLibrary& lib;
   ExpandedShader& out;
   std::set<std::string> included;
-  std::vector<std::string> stack;
 
   void expandFile(const std::string& path, const std::string& from) {
-    if (included.count(path)) return;  // every file once (#pragma once semantics)
-    for (const auto& s : stack)
-      if (s == path) throw Error("shader include cycle through " + path + " (from " + from + ")");
+    if (included.count(path)) return;  // every file once (#pragma once semantics), so cycles end here
     std::string text;
     try {
       text = lib.read(path);
@@ -53,7 +50,6 @@ struct Expander {
       throw Error(from.empty() ? std::string(e.what()) : from + ": " + e.what());
     }
     included.insert(path);
-    stack.push_back(path);
     int fileIndex = static_cast<int>(out.files.size());
     out.files.push_back(path);
     out.source += "#line 1 " + std::to_string(fileIndex) + "\n";
@@ -78,7 +74,6 @@ struct Expander {
         out.source += line + "\n";
       }
     }
-    stack.pop_back();
   }
 };
 
@@ -117,7 +112,7 @@ ExpandedShader ShaderLibrary::expand(const std::string& entry, const std::vector
   ExpandedShader out;
   out.source = "#version 430 core\n";
   for (const auto& d : defines) out.source += "#define " + d + " 1\n";
-  Expander ex{*this, out, {}, {}};
+  Expander ex{*this, out, {}};
   ex.expandFile(normalizePath("", entry), "");
   return out;
 }

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -220,6 +219,18 @@ std::vector<Triangle> degenerateTriangles(int count, Rng& rng) {
   return tris;
 }
 
+// Triangles with an infinite or NaN coordinate (they must never hit, and must not upset the BVH).
+std::vector<Triangle> nonFiniteTriangles(int count, Rng& rng) {
+  const float bad[] = {kInf, -kInf, std::numeric_limits<float>::quiet_NaN()};
+  std::vector<Triangle> tris;
+  for (int i = 0; i < count; ++i) {
+    Triangle t = makeTri(rng.onSphere(), rng.onSphere(), rng.onSphere());
+    t.p[i % 3][(i / 3) % 3] = bad[(i / 9) % 3];
+    tris.push_back(t);
+  }
+  return tris;
+}
+
 // Checks the structural invariants of a BVH built over tris.
 void checkStructure(const Bvh& bvh, const std::vector<Triangle>& tris, int maxLeafSize) {
   const std::size_t n = tris.size();
@@ -382,13 +393,16 @@ TEST_CASE("intersectTriangle: watertight on shared edges and vertices") {
   CHECK(misses == 0);
 }
 
-TEST_CASE("intersectTriangle: degenerate triangles never hit") {
+TEST_CASE("intersectTriangle: degenerate and non-finite triangles never hit") {
   Rng rng(5);
-  const std::vector<Triangle> tris = degenerateTriangles(400, rng);
+  std::vector<Triangle> tris = degenerateTriangles(400, rng);
+  const std::vector<Triangle> bad = nonFiniteTriangles(100, rng);
+  tris.insert(tris.end(), bad.begin(), bad.end());
   int hits = 0;
   for (const Triangle& tri : tris)
     for (int k = 0; k < 25; ++k) {
-      const glm::vec3 target = glm::mix(tri.p[0], tri.p[2], float(k % 5) / 4.0f);
+      glm::vec3 target = glm::mix(tri.p[0], tri.p[2], float(k % 5) / 4.0f);
+      if (!std::isfinite(target.x + target.y + target.z)) target = tri.p[(k + 1) % 3];
       const glm::vec3 o = target + 2.0f * rng.onSphere();
       float t, u, v;
       hits += intersectTriangle(makeRay(o, target - o), tri.p[0], tri.p[1], tri.p[2], kInf, t, u, v);
@@ -441,7 +455,7 @@ TEST_CASE("bvh: agrees with brute force on a random triangle soup") {
   CHECK(hits > 12000);
 }
 
-TEST_CASE("bvh: agrees with brute force with degenerate, huge and tiny triangles") {
+TEST_CASE("bvh: agrees with brute force with degenerate, non-finite, huge and tiny triangles") {
   Rng rng(4);
   std::vector<Triangle> tris = randomSoup(200, rng);
   const std::vector<Triangle> degenerate = degenerateTriangles(150, rng);
@@ -450,6 +464,8 @@ TEST_CASE("bvh: agrees with brute force with degenerate, huge and tiny triangles
     const glm::vec3 a = rng.inBox(glm::vec3(-1.0f), glm::vec3(1.0f)), d = 0.3f * rng.onSphere();
     tris.push_back(makeTri(a, a + d, a + 2.0f * d + 1e-7f * rng.onSphere()));
   }
+  const std::vector<Triangle> bad = nonFiniteTriangles(30, rng);
+  tris.insert(tris.end(), bad.begin(), bad.end());
   for (int i = 0; i < 100; ++i) {  // huge: around 1e15 units away, 1e14 across
     const glm::vec3 c = 1e15f * rng.onSphere();
     tris.push_back(makeTri(c + 1e14f * rng.onSphere(), c + 1e14f * rng.onSphere(), c + 1e14f * rng.onSphere()));

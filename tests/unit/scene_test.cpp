@@ -78,7 +78,8 @@ struct Gltf {
   template <class T>
   int accessor(const std::vector<T>& values, int componentType, const char* type, bool normalized = false) {
     while (bin.size() % 4) bin += '\0';
-    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", values.size() * sizeof(T)}});
+    doc["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", values.size() * sizeof(T)}});
     bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
     const std::size_t components = std::string(type) == "SCALAR" ? 1 : std::size_t(type[3] - '0');
     json acc = {{"bufferView", doc["bufferViews"].size() - 1},
@@ -245,7 +246,8 @@ TEST_CASE("cornell-glass: glass and mirror spheres and the classic light") {
   for (const auto& t : s.triangles) {
     if (&s.materials[t.material] != glass) continue;
     ++sphereTriangles;
-    for (const auto& p : t.p) CHECK(glm::length(p - glm::vec3(-0.42f, 0.35f, 0.3f)) == doctest::Approx(0.35).epsilon(1e-4));
+    for (const auto& p : t.p)
+      CHECK(glm::length(p - glm::vec3(-0.42f, 0.35f, 0.3f)) == doctest::Approx(0.35).epsilon(1e-4));
   }
   CHECK(sphereTriangles > 1000);
 }
@@ -428,7 +430,8 @@ TEST_CASE("primitives: index types, non-indexed, strips, fans, flat normals, deg
       Gltf g;
       const std::vector<float> strip = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0};
       const std::vector<float> fan = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0.5f, 2, 0, 0, 1, 0};
-      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(mode == 5 ? strip : fan)}}}, {"mode", mode}})}});
+      const int pos = g.positions(mode == 5 ? strip : fan);
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}}}, {"mode", mode}})}});
       const Scene s = g.load(dir);
       CHECK(s.triangles.size() == 3);
       for (const auto& t : s.triangles) CHECK(near(geometricNormal(t), glm::vec3(0, 0, 1)));
@@ -631,9 +634,10 @@ TEST_CASE("textures: external PNG and JPEG files, samplers, emissive texture") {
   g.doc["images"] = {{{"uri", "tiny.png"}}, {{"uri", "flat.jpg"}}};
   g.doc["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}, {"magFilter", 9728}}};
   g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}, {{"source", 1}}};
-  const int mat = g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}}},
-                                      {"emissiveFactor", {1, 1, 1}},
-                                      {"emissiveTexture", {{"index", 1}}}});
+  const int mat = g.add("materials",
+                        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}}},
+                         {"emissiveFactor", {1, 1, 1}},
+                         {"emissiveTexture", {{"index", 1}}}});
   g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", mat}})}});
   const Scene s = g.load(dir);
   REQUIRE(s.textures.size() == 2);
@@ -654,6 +658,18 @@ TEST_CASE("textures: external PNG and JPEG files, samplers, emissive texture") {
   CHECK(emissive.repeatS);  // no sampler: REPEAT
 }
 
+TEST_CASE("external buffers: percent-encoded file names") {
+  TempDir dir;
+  Gltf g;
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}})}});
+  dir.write("my data.bin", g.bin);
+  json doc = g.doc;
+  doc["buffers"] = json::array({{{"byteLength", g.bin.size()}, {"uri", "my%20data.bin"}}});
+  const Scene s = caustica::loadScene(dir.write("external.gltf", doc.dump()));
+  REQUIRE(s.triangles.size() == 1);
+  CHECK(near(s.triangles[0].p[2], glm::vec3(0, 1, 0)));
+}
+
 TEST_CASE("bad input files throw caustica::Error naming the file and the problem") {
   struct Case {
     const char* file;
@@ -671,6 +687,7 @@ TEST_CASE("bad input files throw caustica::Error naming the file and the problem
       {"unknown-required-extension.gltf", "EXT_caustica_unknown"},
       {"lines-only.gltf", "no triangles"},
       {"empty-scene.gltf", "no triangles"},
+      {"degenerate-only.gltf", "zero area"},
       {"index-out-of-range.gltf", "index 99"},
       {"accessor-overrun.gltf", "overrun"},
       {"bufferview-overrun.gltf", "bufferViews[1]"},
