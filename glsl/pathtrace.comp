@@ -148,7 +148,10 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
       if (transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0)  // shading normal misled: use ng
         weight = sampleDielectric(dir, ng, eta, u, newDir, transmitted);
       beta *= weight;
-      if (transmitted) etaScale *= eta * eta;
+      if (transmitted) {
+        beta *= base.rgb;  // KHR_materials_transmission: transmitted light is tinted by the base colour
+        etaScale *= eta * eta;
+      }
 #ifdef CAUSTICA_VOLUME
       if (transmitted) sigma = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
 #endif

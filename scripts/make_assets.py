@@ -535,19 +535,19 @@ def cornell_textured():
 def cornell_dispersion():
     g = Gltf()
     dark = (0.12, 0.12, 0.12)
-    # Dark box with a white floor and a white right wall, where the rainbow lands.
-    add_cornell_box(g, wall_colors={"ceiling": dark, "back": dark, "left": dark, "right": WHITE})
-    # A narrow, very bright strip light above the left half: its small angular width along x keeps
-    # the colours of the prism's spectrum apart. White light, radiance 200.
-    add_ceiling_light(g, 0.05, 0.4, emissive=(1.0, 1.0, 1.0), strength=200.0, x=-0.6)
-    side, length, centre_y = 0.5, 0.8, 0.8
+    # Dark box with a white floor, where the coloured caustic lands.
+    add_cornell_box(g, wall_colors={"ceiling": dark, "back": dark, "left": dark, "right": dark})
+    # A small, bright white light straight above a ball lens of strongly dispersive glass. The lens
+    # (radius 0.3 m, centre 0.68 m above the floor) images the light onto the floor; blue light
+    # focuses closer to the lens than red, so the caustic spreads into coloured rings.
+    add_ceiling_light(g, 0.3, 0.3, emissive=(1.0, 1.0, 1.0), strength=40.0)
+    radius = 0.3
     flint = g.material("dispersive glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0,
-                       ior=1.5, thickness=side, dispersion=0.8)
-    g.object("prism", prism(side, length), flint, translation=(0.0, centre_y, 0.0))
-    stand = g.material("stand", color=(0.1, 0.1, 0.1))
-    stand_height = centre_y - side / (2.0 * math.sqrt(3.0))
-    g.object("prism stand", unit_cube(), stand, translation=(0.0, stand_height / 2.0, 0.0),
-             scale_=(0.12, stand_height, 0.5))
+                       ior=1.5, thickness=2 * radius, dispersion=1.2)
+    g.object("dispersive sphere", uv_sphere(radius, 64, 32), flint, translation=(0.0, 0.68, 0.0))
+    # A 60-degree prism on the floor to the right bends the same light into a spectrum.
+    side, length = 0.35, 0.5
+    g.object("prism", prism(side, length), flint, translation=(0.55, side / (2.0 * math.sqrt(3.0)), 0.35))
     g.camera("camera", **CORNELL_CAMERA)
     return g.finish()
 

@@ -347,7 +347,7 @@ class Bench {
                        const RenderSettings& rs, const std::string& name, int referenceSpp, Reference& ref) {
     Renderer r(library, scene, camera, rs);
     const int half = referenceSpp / 2;
-    const int maxBatch = std::max(1, (1 << 27) / std::max(1, rs.width * rs.height));
+    const int maxBatch = std::max(1, (1 << 26) / std::max(1, rs.width * rs.height));
     auto start = Clock::now();
     int batch = 1;
     double lastPrint = -1.0;
@@ -395,7 +395,7 @@ class Bench {
     renderer.reset();
     const std::vector<double> schedule = checkpointSchedule(kFirstCheckpoint, maxSeconds_, kCheckpointsPerOctave);
     const double pixels = double(s.width) * s.height;
-    const int maxBatch = std::max(1, (1 << 27) / std::max(1, s.width * s.height));  // 32-bit GPU ray counters
+    const int maxBatch = std::max(1, (1 << 26) / std::max(1, s.width * s.height));  // 32-bit GPU ray counters per dispatch
     double elapsed = 0.0;
     size_t next = 0;
     while (next < schedule.size()) {

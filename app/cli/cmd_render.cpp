@@ -1,6 +1,7 @@
 // cmd_render.cpp — `caustica render`: headless progressive render of a scene to an image file.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/cli_common.h"
@@ -74,7 +75,7 @@ int cmdRender(const std::vector<std::string>& args) {
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
   writeImage(out, renderer.image(), tone);
-  note(quiet, "wrote " + out);
+  note(quiet, "wrote " + std::filesystem::absolute(out).string());
   return 0;
 }
 

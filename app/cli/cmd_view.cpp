@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
-#include <limits>
 #include <memory>
+#include <vector>
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
@@ -89,7 +89,7 @@ class Viewer {
   void syncRenderer();
   void copyPreview();
   void warmUp();
-  void renderWithin(double budgetMs);
+  void renderWithin(double budgetMs, bool stopAtPassEnd = false);
   int choosePassSpp() const;
   void present();
   void finishPass();
@@ -134,14 +134,18 @@ class Viewer {
   bool displayFbStale_ = true;
 
   // Interaction state.
-  bool paused_ = false, fly_ = false, screenshotPending_ = false, needPresent_ = true;
-  bool dragging_ = false;
+  bool paused_ = false, fly_ = false, screenshotPending_ = false;
+  bool redraw_ = true;       // present at the end of this iteration (restart, exposure, damage...)
+  bool newSamples_ = false;  // samples not presented yet (presented at a rate that bounds display cost)
   double lastX_ = 0.0, lastY_ = 0.0;
 
   // Statistics.
   std::uint64_t samples_ = 0;  // pixel samples traced since start
-  int frames_ = 0;
-  double frameMs_ = 0.0;       // EMA of the wall time per frame
+  int frames_ = 0;             // loop iterations: input, at most one budget of path tracing, maybe a shown frame
+  double lastInput_ = 0.0;     // seconds
+  int presented_ = 0;          // frames shown
+  double lastPresent_ = 0.0;   // seconds
+  double frameMs_ = 0.0;       // EMA of the time between presented frames, milliseconds
   double lastTitle_ = -1.0, rateT0_ = 0.0;
   std::uint64_t rateS0_ = 0;
   double samplesPerSecond_ = 0.0;
@@ -171,6 +175,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config) : config_(config) 
   library_ = std::make_unique<ShaderLibrary>(shaderLibraryFrom(opts));
   renderer_ = std::make_unique<Renderer>(*library_, scene_.scene, scene_.camera, settings);
   warmUp();
+  present();  // compiles the tone-mapping shader and whatever the blit needs, before anything is timed
+  presented_ = 0;
   controller_ = std::make_unique<CameraController>(scene_.camera, scene_.scene.bounds);
   appliedRevision_ = controller_->revision();
   note(config_.quiet, scene_.scene.path + ": " + std::to_string(scene_.scene.triangles.size()) + " triangles, features: " +
@@ -188,7 +194,7 @@ void Viewer::handleInput(double dt) {
     if (k.repeat && k.key != GLFW_KEY_R) continue;
     switch (k.key) {
       case GLFW_KEY_ESCAPE: window_->requestClose(); break;
-      case GLFW_KEY_SPACE: paused_ = !paused_; needPresent_ = true; break;
+      case GLFW_KEY_SPACE: paused_ = !paused_; break;
       case GLFW_KEY_R: controller_->reset(); break;
       case GLFW_KEY_F: fly_ = !fly_; break;
       case GLFW_KEY_I: integrator_ = integrator_ == Integrator::Mis ? Integrator::Naive : Integrator::Mis; break;
@@ -197,7 +203,7 @@ void Viewer::handleInput(double dt) {
         break;
       case GLFW_KEY_T:
         config_.tone.curve = config_.tone.curve == ToneCurve::Aces ? ToneCurve::Clamp : ToneCurve::Aces;
-        needPresent_ = true;
+        redraw_ = true;
         break;
       case GLFW_KEY_P: screenshotPending_ = true; break;
       case GLFW_KEY_H: std::cout << kControls << std::flush; break;
@@ -220,7 +226,7 @@ void Viewer::handleInput(double dt) {
     } else {
       continue;
     }
-    needPresent_ = true;
+    redraw_ = true;
   }
 
   // Mouse: cursor motion since the last frame, in screen coordinates (y down).
@@ -286,10 +292,9 @@ void Viewer::syncRenderer() {
   bool wantPreview = slow && (moving || restarted || (previewing_ && previewPasses_ == 0));
   bool leaving = false;
   if (wantPreview) {
-    if (!previewing_) {
-      double scale = std::ceil(std::sqrt(costMs_ * fullW_ * fullH_ / (0.5 * config_.budgetMs)));
-      previewScale_ = static_cast<int>(std::clamp(scale, 2.0, 16.0));
-    }
+    // Preview passes should take about half the budget. Re-chosen at restarts, with some hysteresis.
+    int scale = static_cast<int>(std::clamp(std::ceil(std::sqrt(costMs_ * fullW_ * fullH_ / (0.5 * config_.budgetMs))), 2.0, 16.0));
+    if (!previewing_ || (restarted && std::abs(scale - previewScale_) >= 2)) previewScale_ = scale;
     int pw = std::max(1, fullW_ / previewScale_), ph = std::max(1, fullH_ / previewScale_);
     if (s.width != pw || s.height != ph) {
       renderer_->resize(pw, ph);
@@ -313,7 +318,7 @@ void Viewer::syncRenderer() {
     bandY_ = 0;
     previewPasses_ = 0;
     showPreviewCopy_ = leaving;
-    needPresent_ = true;
+    redraw_ = true;
   }
 }
 
@@ -336,7 +341,7 @@ int Viewer::choosePassSpp() const {
   return spp;
 }
 
-void Viewer::renderWithin(double budgetMs) {
+void Viewer::renderWithin(double budgetMs, bool stopAtPassEnd) {
   if (done()) return;
   const double t0 = now();
   const int w = renderer_->settings().width, h = renderer_->settings().height;
@@ -358,12 +363,8 @@ void Viewer::renderWithin(double budgetMs) {
     double ratio = ms / std::max(predicted, 1e-9);
     for (int y = bandY_; y < y1; ++y) rowCost_[y] = (rowCost_[y] > 0.0 ? rowCost_[y] : costMs_) * ratio;
     costMs_ += 0.3 * (ms / n - costMs_);
-    if (std::getenv("CAUSTICA_VIEW_DEBUG"))
-      std::fprintf(stderr, "band %d..%d of %dx%d, %d spp: %.2f ms (predicted %.2f), mean %.3g ms/sample, preview %d (1/%d), spp %d\n",
-                   bandY_, y1, w, h, passSpp_, ms, predicted, costMs_, previewing_, previewScale_, renderer_->samplesPerPixel());
-    if (previewing_ && ms > 1.5 * budgetMs && previewScale_ < 16) ++previewScale_;  // applies at the next restart
     bandY_ = y1;
-    needPresent_ = true;
+    newSamples_ = true;
     if (bandY_ >= h) {
       renderer_->endPass(passSpp_);
       bandY_ = 0;
@@ -376,7 +377,7 @@ void Viewer::renderWithin(double budgetMs) {
           screenshotPending_ = false;
         }
       }
-      if (done()) break;
+      if (done() || stopAtPassEnd) break;
     }
     if (budgetMs - (now() - t0) * 1000.0 < rowMs(bandY_)) break;  // not one more row fits
   }
@@ -416,9 +417,13 @@ void Viewer::present() {
   glFinish();  // so the time below is the GPU's
   checkGlError("presenting the image");
   double ms = (now() - t) * 1000.0;
-  displayMs_ += 0.2 * (ms - displayMs_);
+  displayMs_ += (presented_ <= 1 ? 1.0 : 0.2) * (ms - displayMs_);
   window_->swapBuffers();
-  needPresent_ = false;
+  redraw_ = newSamples_ = false;
+  double end = now();
+  if (presented_ > 0) frameMs_ += (presented_ == 1 ? 1.0 : 0.1) * ((end - lastPresent_) * 1000.0 - frameMs_);
+  lastPresent_ = end;
+  ++presented_;
 }
 
 void Viewer::finishPass() {
@@ -426,7 +431,7 @@ void Viewer::finishPass() {
   for (;;) {
     syncRenderer();
     if (done() || (!previewing_ && bandY_ == 0 && renderer_->samplesPerPixel() > 0)) break;
-    renderWithin(config_.budgetMs);
+    renderWithin(config_.budgetMs, true);
     window_->pollEvents();
     present();
   }
@@ -457,29 +462,30 @@ void Viewer::updateTitle(bool force) {
 
 void Viewer::writeScreenshotPair() {
   std::string base = "caustica-" + sceneName_ + "-" + std::to_string(renderer_->samplesPerPixel()) + "spp";
-  Image img = renderer_->image();
-  writeImage(base + ".png", img, config_.tone);
-  writeImage(base + ".exr", img);
-  note(config_.quiet, "wrote " + base + ".png and " + base + ".exr");
+  try {
+    Image img = renderer_->image();
+    writeImage(base + ".png", img, config_.tone);
+    writeImage(base + ".exr", img);
+    note(config_.quiet, "wrote " + base + ".png and " + base + ".exr");
+  } catch (const Error& e) {  // a failed screenshot is no reason to close the window
+    std::cerr << "caustica view: screenshot failed: " << e.what() << "\n";
+  }
 }
 
 int Viewer::run() {
   const double loopStart = now();
-  double last = loopStart;
   bool closed = false;
   for (;;) {
     bool idle = paused_ || done();
-    if (idle && !needPresent_ && !screenshotPending_) window_->waitEvents(0.1);
+    if (idle && !redraw_ && !newSamples_ && !screenshotPending_) window_->waitEvents(0.1);
     else window_->pollEvents();
     if (window_->shouldClose()) {
       closed = true;
       break;
     }
     double t = now();
-    double dt = t - last;
-    last = t;
-    frameMs_ = frames_ == 0 ? dt * 1000.0 : frameMs_ + 0.1 * (dt * 1000.0 - frameMs_);
-    handleInput(std::min(dt, 0.1));
+    handleInput(std::min(t - lastInput_, 0.1));
+    lastInput_ = t;
     int fw = 0, fh = 0;
     window_->framebufferSize(fw, fh);
     if (fw > 0 && fh > 0) {  // not minimised
@@ -488,16 +494,23 @@ int Viewer::run() {
         fullH_ = fh;
         lastMotion_ = t;
       }
-      if (window_->exposed()) needPresent_ = true;
+      if (window_->exposed()) redraw_ = true;
+      // Showing the image costs GPU time too (tone mapping, blit): while the view is still, frames are
+      // shown at most at the rate that keeps that cost within a quarter of the time.
+      auto presentDue = [&] {
+        return redraw_ || previewing_ || paused_ || done() || (now() - lastPresent_) * 1000.0 + 1e-3 >= 4.0 * displayMs_;
+      };
       if (!paused_) {
         syncRenderer();
-        renderWithin(std::max(config_.budgetMs - displayMs_, 0.25 * config_.budgetMs));
+        double budget = config_.budgetMs;
+        if (presentDue()) budget = std::max(budget - displayMs_, 0.25 * budget);
+        renderWithin(budget);
       }
       if (screenshotPending_ && (paused_ || done())) {
         writeScreenshotPair();
         screenshotPending_ = false;
       }
-      if (needPresent_) present();
+      if (redraw_ || (newSamples_ && presentDue())) present();
     }
     updateTitle(false);
     ++frames_;
@@ -505,13 +518,14 @@ int Viewer::run() {
   }
   const double loopSeconds = now() - loopStart;
   const std::uint64_t loopSamples = samples_;
+  const int loopPresented = presented_;
   if (config_.frameLimit > 0 && !closed) finishPass();
   if (config_.frameLimit > 0) {
     updateTitle(true);
-    std::printf("frames %d in %.2f s: %.1f ms/frame, %.1f fps, %.3g samples/s; %dx%d, %d spp\n", frames_, loopSeconds,
-                1000.0 * loopSeconds / std::max(frames_, 1), frames_ / std::max(loopSeconds, 1e-9),
-                static_cast<double>(loopSamples) / std::max(loopSeconds, 1e-9), renderer_->settings().width,
-                renderer_->settings().height, renderer_->samplesPerPixel());
+    std::printf("%d frames in %.2f s (%.1f ms/frame), %d shown (%.1f fps), %.3g samples/s; %dx%d, %d spp\n", frames_,
+                loopSeconds, 1000.0 * loopSeconds / std::max(frames_, 1), loopPresented,
+                loopPresented / std::max(loopSeconds, 1e-9), static_cast<double>(loopSamples) / std::max(loopSeconds, 1e-9),
+                renderer_->settings().width, renderer_->settings().height, renderer_->samplesPerPixel());
   }
   if (!config_.screenshotPath.empty()) {
     writeImage(config_.screenshotPath, renderer_->image(), config_.tone);

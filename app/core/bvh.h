@@ -12,7 +12,7 @@ namespace caustica {
 
 struct BvhBuildOptions {
   int bins = 16;            // SAH bins per axis
-  int maxLeafSize = 4;      // leaves never hold more triangles than this (unless all centroids coincide)
+  int maxLeafSize = 4;      // leaves never hold more triangles than this
   float costTraversal = 1.0f;   // SAH cost of visiting an inner node
   float costIntersect = 1.0f;   // SAH cost of one ray-triangle test
 };

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include "core/error.h"
 
@@ -28,6 +29,12 @@ GlLimits queryGlLimits() {
   GLint64 block = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
   l.maxStorageBlockSize = block;
+  // CAUSTICA_MAX_SSBO_BYTES lowers the limit, to see how a scene fares on a GPU that offers only the
+  // 16 MiB the specification guarantees (used by the tests).
+  if (const char* env = std::getenv("CAUSTICA_MAX_SSBO_BYTES")) {
+    long long cap = std::atoll(env);
+    if (cap > 0 && cap < l.maxStorageBlockSize) l.maxStorageBlockSize = cap;
+  }
   glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &l.maxComputeStorageBlocks);
   glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &l.maxWorkGroupInvocations);
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.maxTextureSize);

@@ -70,7 +70,7 @@ struct Scene {
   std::vector<Triangle> triangles;
   std::vector<Material> materials;   // never empty after loading (a default diffuse is added if needed)
   std::vector<Texture> textures;
-  std::vector<Camera> cameras;       // perspective cameras in document order (may be empty)
+  std::vector<Camera> cameras;       // perspective cameras in the default scene's node-visit order (may be empty)
   std::vector<std::string> warnings; // things skipped or approximated, each naming the file
   Bounds bounds;
 };

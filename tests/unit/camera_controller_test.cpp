@@ -68,7 +68,7 @@ TEST_CASE("camera controller: starts at the home camera with the target at the s
   checkNear(cc.worldUp(), glm::vec3(0, 1, 0), 1e-7f);
 }
 
-TEST_CASE("camera controller: world up is the axis nearest the camera's up, even when pitched") {
+TEST_CASE("camera controller: world up is the axis nearest the camera's up even when pitched") {
   Camera c = frontCamera();
   c.forward = glm::normalize(glm::vec3(0.0f, -0.5f, -1.0f));
   c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::vec3(0, 1, 0)), c.forward));
@@ -174,7 +174,7 @@ TEST_CASE("camera controller: dolly approaches the target and never passes it") 
   checkNear(cc.target(), target);
 }
 
-TEST_CASE("camera controller: fly look turns in place, move translates camera and target") {
+TEST_CASE("camera controller: fly look turns in place while move translates camera and target") {
   CameraController cc(frontCamera(), unitBox());
   glm::vec3 pos = cc.camera().position;
   cc.look(0.0f, 0.3f);  // look up
@@ -208,7 +208,7 @@ TEST_CASE("camera controller: reset restores the home camera exactly after any m
   CHECK(cc.targetDistance() == doctest::Approx(5.0f));
 }
 
-TEST_CASE("camera controller: no motion, no change") {
+TEST_CASE("camera controller: no motion means no change") {
   CameraController cc(frontCamera(), unitBox());
   std::uint64_t rev = cc.revision();
   cc.orbit(0, 0);
@@ -220,7 +220,7 @@ TEST_CASE("camera controller: no motion, no change") {
   CHECK(cc.camera().position == frontCamera().position);
 }
 
-TEST_CASE("camera controller: long random sequences stay orthonormal, finite and within the limits") {
+TEST_CASE("camera controller: long random sequences stay orthonormal and finite within the limits") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   Camera tilted = frontCamera();
