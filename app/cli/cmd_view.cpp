@@ -443,7 +443,7 @@ void Viewer::updateTitle(bool force) {
   double t = now();
   if (!force && t - lastTitle_ < 0.25) return;
   if (t - rateT0_ >= 1.0) {
-    samplesPerSecond_ = static_cast<double>(samples_ - rateS0_) / (t - rateT0_);
+    if (samples_ != rateS0_) samplesPerSecond_ = static_cast<double>(samples_ - rateS0_) / (t - rateT0_);  // idle: keep
     rateT0_ = t;
     rateS0_ = samples_;
   }
