@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/bvh.h"
+#include "core/obj_mesh.h"
 #include "core/error.h"
 
 using namespace caustica;
@@ -34,37 +35,6 @@ Triangle makeTri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
   return t;
 }
 
-// Minimal OBJ reader: `v` and `f` lines (fan-triangulated; v/vt/vn and negative indices).
-std::vector<Triangle> loadObj(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open");
-  std::vector<glm::vec3> verts;
-  std::vector<Triangle> tris;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string tag;
-    ls >> tag;
-    if (tag == "v") {
-      glm::vec3 p;
-      ls >> p.x >> p.y >> p.z;
-      verts.push_back(p);
-    } else if (tag == "f") {
-      std::vector<int> idx;
-      std::string tok;
-      while (ls >> tok) {
-        const int i = std::stoi(tok.substr(0, tok.find('/')));
-        idx.push_back(i < 0 ? int(verts.size()) + i : i - 1);
-      }
-      for (std::size_t k = 2; k < idx.size(); ++k) {
-        if (idx[0] < 0 || idx[k] >= int(verts.size()) || idx[k - 1] < 0)
-          throw Error(path + ": face index out of range");
-        tris.push_back(makeTri(verts[idx[0]], verts[idx[k - 1]], verts[idx[k]]));
-      }
-    }
-  }
-  return tris;
-}
 
 // UV sphere of radius ~1 with a bumpy displacement: 2 * nu * (nv - 1) triangles (one per pole cell).
 std::vector<Triangle> displacedSphere(int nu, int nv) {
@@ -162,7 +132,7 @@ int main(int argc, char** argv) {
       int rays, repeats;
     };
     std::vector<Mesh> meshes;
-    meshes.push_back({"bunny", loadObj(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj"), 200000, 5});
+    meshes.push_back({"bunny", loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj"), 200000, 5});
     meshes.push_back({"sphere1M", displacedSphere(1024, 512), 100000, 3});
 
     std::vector<Row> rows;

@@ -467,15 +467,20 @@ def add_ceiling_light(g, width, depth, emissive=WARM_LIGHT[0], strength=WARM_LIG
     g.object("ceiling light", ceiling_light(width, depth, x=x, z=z), light)
 
 
+def add_two_boxes(g, material):
+    """The classic tall and short boxes, rotated, resting on the floor."""
+    cube = unit_cube()
+    g.object("tall box", cube, material, translation=(-0.38, 0.6, -0.35), rotation=quat_y(17.0),
+             scale_=(0.6, 1.2, 0.6))
+    g.object("short box", cube, material, translation=(0.38, 0.3, 0.38), rotation=quat_y(-17.0),
+             scale_=(0.6, 0.6, 0.6))
+
+
 def cornell_box():
     g = Gltf()
     white = add_cornell_box(g)
     add_ceiling_light(g, 0.47, 0.38)
-    cube = unit_cube()
-    g.object("tall box", cube, white, translation=(-0.38, 0.6, -0.35), rotation=quat_y(17.0),
-             scale_=(0.6, 1.2, 0.6))
-    g.object("short box", cube, white, translation=(0.38, 0.3, 0.38), rotation=quat_y(-17.0),
-             scale_=(0.6, 0.6, 0.6))
+    add_two_boxes(g, white)
     g.camera("camera", **CORNELL_CAMERA)
     return g.finish()
 
@@ -523,11 +528,7 @@ def cornell_textured():
     add_cornell_box(g, textured=True)
     add_ceiling_light(g, 0.47, 0.38)
     white = g.material("white boxes", color=WHITE)
-    cube = unit_cube()
-    g.object("tall box", cube, white, translation=(-0.38, 0.6, -0.35), rotation=quat_y(17.0),
-             scale_=(0.6, 1.2, 0.6))
-    g.object("short box", cube, white, translation=(0.38, 0.3, 0.38), rotation=quat_y(-17.0),
-             scale_=(0.6, 0.6, 0.6))
+    add_two_boxes(g, white)
     g.camera("camera", **CORNELL_CAMERA)
     return g.finish()
 

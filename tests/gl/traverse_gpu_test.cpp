@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/bvh.h"
+#include "core/obj_mesh.h"
 #include "core/gl_objects.h"
 #include "core/shader_library.h"
 #include "gl_test_util.h"
@@ -15,32 +16,6 @@ using namespace caustica;
 
 namespace {
 
-std::vector<Triangle> loadObj(const std::string& path) {
-  std::ifstream f(path);
-  REQUIRE_MESSAGE(f.good(), "cannot open " << path);
-  std::vector<glm::vec3> v;
-  std::vector<Triangle> tris;
-  std::string line;
-  while (std::getline(f, line)) {
-    std::istringstream ss(line);
-    std::string tag;
-    ss >> tag;
-    if (tag == "v") {
-      glm::vec3 p;
-      ss >> p.x >> p.y >> p.z;
-      v.push_back(p);
-    } else if (tag == "f") {
-      int a, b, c;
-      ss >> a >> b >> c;
-      Triangle t{};
-      t.p[0] = v[a - 1];
-      t.p[1] = v[b - 1];
-      t.p[2] = v[c - 1];
-      tris.push_back(t);
-    }
-  }
-  return tris;
-}
 
 std::vector<Triangle> randomSoup(int n, std::mt19937& g) {
   std::uniform_real_distribution<float> u(-1, 1);
@@ -120,7 +95,7 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
 }  // namespace
 
 TEST_CASE("GPU traversal equals the C++ twin: bunny") {
-  compareGpuWithTwin(loadObj(test::sourcePath("assets/meshes/bunny.obj")), 20000, 1);
+  compareGpuWithTwin(loadObjTriangles(test::sourcePath("assets/meshes/bunny.obj")), 20000, 1);
 }
 
 TEST_CASE("GPU traversal equals the C++ twin: random soup with a degenerate triangle") {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/bvh.h"
+#include "core/obj_mesh.h"
 #include "core/error.h"
 
 using namespace caustica;
@@ -29,37 +30,9 @@ Triangle makeTri(glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t material =
   return t;
 }
 
-// Minimal OBJ reader: `v x y z` and `f a b c ...` (fan-triangulated; v/vt/vn and negative indices).
-std::vector<Triangle> loadObj(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open");
-  std::vector<glm::vec3> verts;
-  std::vector<Triangle> tris;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string tag;
-    ls >> tag;
-    if (tag == "v") {
-      glm::vec3 p;
-      ls >> p.x >> p.y >> p.z;
-      verts.push_back(p);
-    } else if (tag == "f") {
-      std::vector<int> idx;
-      std::string tok;
-      while (ls >> tok) {
-        int i = std::stoi(tok.substr(0, tok.find('/')));
-        idx.push_back(i < 0 ? int(verts.size()) + i : i - 1);
-      }
-      for (std::size_t k = 2; k < idx.size(); ++k)
-        tris.push_back(makeTri(verts.at(idx[0]), verts.at(idx[k - 1]), verts.at(idx[k])));
-    }
-  }
-  return tris;
-}
 
 std::vector<Triangle> loadBunny() {
-  return loadObj(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+  return loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
 }
 
 struct Rng {
