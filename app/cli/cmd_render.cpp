@@ -1,4 +1,6 @@
 // cmd_render.cpp — `caustica render`: headless progressive render of a scene to an image file.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -50,6 +52,7 @@ int cmdRender(const std::vector<std::string>& args) {
   // Samples per dispatch grow while a dispatch stays short, so progress and GPU watchdogs stay happy.
   auto start = std::chrono::steady_clock::now();
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const bool tty = isatty(STDERR_FILENO) != 0;
   int batch = 1;
   double lastPrint = -1.0;
   while (renderer.samplesPerPixel() < spp) {
@@ -60,15 +63,17 @@ int cmdRender(const std::vector<std::string>& args) {
     if (dt < 0.05 && batch < 256) batch *= 2;
     else if (dt > 0.5 && batch > 1) batch /= 2;
     double now = seconds();
-    if (!quiet && (now - lastPrint > 0.5 || renderer.samplesPerPixel() == spp)) {
+    // On a terminal the progress line updates in place; in logs a line every 10 s.
+    if (!quiet && (now - lastPrint > (tty ? 0.5 : 10.0) || renderer.samplesPerPixel() == spp)) {
       lastPrint = now;
       double eta = now / renderer.samplesPerPixel() * (spp - renderer.samplesPerPixel());
-      std::fprintf(stderr, "\rcaustica: %d/%d spp  %.1f s  eta %.1f s   ", renderer.samplesPerPixel(), spp, now, eta);
+      std::fprintf(stderr, "%scaustica: %d/%d spp  %.1f s  eta %.1f s%s", tty ? "\r" : "", renderer.samplesPerPixel(),
+                   spp, now, eta, tty ? "   " : "\n");
       std::fflush(stderr);
     }
   }
   double total = seconds();
-  if (!quiet) std::fprintf(stderr, "\n");
+  if (!quiet && tty) std::fprintf(stderr, "\n");
   const RenderStats& st = renderer.stats();
   char line[256];
   std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s, non-finite samples: %llu", total,
