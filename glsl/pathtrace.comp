@@ -84,8 +84,10 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
     uint lobe = chooseLobe(m, rand01(rng));
     if (lobe == kLobeDiffuse) {
 #ifdef CAUSTICA_MIS
+      // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
+      // traced (not at the last vertex the depth limit allows), so both estimators end alike.
       LightSample ls;
-      if (sampleLight(rand01(rng), rand01(rng), rand2(rng), ls)) {
+      if (depth + 1u < maxDepth && sampleLight(rand01(rng), rand01(rng), rand2(rng), ls)) {
         vec3 toLight = ls.p - p;
         float dist2 = dot(toLight, toLight);
         float dist = sqrt(dist2);
@@ -99,7 +101,11 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
           // Stop just short of the light so its own triangle (and coplanar neighbours) do not occlude.
           if (!traceOccluded(offsetRayOrigin(p, ng), wl, dist * (1.0 - 1.0e-4))) {
             float w = powerHeuristic(pdfLight, cosSurf * INV_PI);
-            radiance += beta * filt * base.rgb * (INV_PI * cosSurf * w / pdfLight) * ls.le;
+            vec3 transmittance = vec3(1.0);
+#ifdef CAUSTICA_VOLUME
+            transmittance = exp(-sigma * dist);  // the shadow ray runs inside the same medium
+#endif
+            radiance += beta * filt * base.rgb * (INV_PI * cosSurf * w / pdfLight) * ls.le * transmittance;
           }
         }
       }
@@ -182,6 +188,7 @@ void main() {
     groupCounts[2] = 0u;
     groupCounts[3] = 0u;
   }
+  memoryBarrierShared();
   barrier();
   uint primary = 0u, bad = 0u;
   if (valid) {
@@ -200,6 +207,7 @@ void main() {
   atomicAdd(groupCounts[1], gSecondaryRays);
   atomicAdd(groupCounts[2], gShadowRays);
   atomicAdd(groupCounts[3], bad);
+  memoryBarrierShared();
   barrier();
   if (gl_LocalInvocationIndex == 0u) {
     atomicAdd(counters.primaryRays, groupCounts[0]);

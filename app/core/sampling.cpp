@@ -45,9 +45,9 @@ glm::vec2 sampleTriangleUniform(const glm::vec2& u) {
 }
 
 float powerHeuristic(float a, float b) {
-  if (std::isinf(a)) return 1.0f;
-  float a2 = a * a, b2 = b * b;
-  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+  if (!(a > 0.0f)) return 0.0f;
+  float r = b / a;
+  return 1.0f / (1.0f + r * r);
 }
 
 float fresnelDielectric(float cosI, float eta) {

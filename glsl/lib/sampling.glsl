@@ -30,10 +30,11 @@ vec2 sampleTriangleUniform(vec2 u) {
 }
 
 // Power heuristic (beta = 2) weight of technique a against technique b (pdfs in the same measure).
+// Written as a ratio so that large pdfs (small lights, grazing angles) cannot overflow a^2 to Inf.
 float powerHeuristic(float a, float b) {
-  if (isinf(a)) return 1.0;
-  float a2 = a * a, b2 = b * b;
-  return a2 + b2 > 0.0 ? a2 / (a2 + b2) : 0.0;
+  if (!(a > 0.0)) return 0.0;
+  float r = b / a;
+  return 1.0 / (1.0 + r * r);
 }
 
 // Unpolarised Fresnel reflectance of a smooth dielectric interface. cosI = |cos| of the incident

@@ -32,14 +32,16 @@ struct BlockStats {
 };
 
 BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
-                      int renders, std::uint32_t seedBase, std::uint64_t* nonFinite) {
+                      int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth) {
   BlockStats b;
   b.blocksX = w / block;
   b.blocksY = h / block;
   size_t nb = static_cast<size_t>(b.blocksX) * b.blocksY * 3;
   std::vector<std::vector<double>> per(renders, std::vector<double>(nb, 0.0));
   for (int r = 0; r < renders; ++r) {
-    RenderResult res = renderScene(scene, cam, small(w, h, integrator, seedBase + r), spp);
+    RenderSettings settings = small(w, h, integrator, seedBase + r);
+    settings.maxDepth = maxDepth;
+    RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     for (int y = 0; y < b.blocksY * block; ++y)
       for (int x = 0; x < b.blocksX * block; ++x)
@@ -58,13 +60,13 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
 
 // naive and mis must agree within noise: per block, |difference| within 4.5 standard errors (plus a
 // small relative slack for the variance estimate's own noise), and the image means within 1.5 %.
-void checkEstimatorsAgree(const std::string& scenePath, int w, int h, int sppNaive, int sppMis) {
+void checkEstimatorsAgree(const std::string& scenePath, int w, int h, int sppNaive, int sppMis, int maxDepth = 32) {
   Scene scene = loadScene(sourcePath(scenePath));
   Camera cam = sceneCamera(scene);
   std::uint64_t nonFinite = 0;
   const int block = 8, renders = 8;
-  BlockStats a = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 100, &nonFinite);
-  BlockStats b = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 200, &nonFinite);
+  BlockStats a = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 100, &nonFinite, maxDepth);
+  BlockStats b = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 200, &nonFinite, maxDepth);
   int bad = 0;
   double sumA = 0, sumB = 0;
   std::string worst;
@@ -127,6 +129,11 @@ TEST_CASE("a clear glass sphere inside a uniformly emitting black enclosure is i
 
 TEST_CASE("naive and mis converge to the same image: Cornell box") {
   checkEstimatorsAgree("assets/scenes/cornell-box.gltf", 32, 32, 256, 64);
+}
+
+TEST_CASE("naive and mis converge to the same image at a depth limit of 2: Cornell box") {
+  // Light sampling at the last allowed vertex would add light one bounce beyond the limit.
+  checkEstimatorsAgree("assets/scenes/cornell-box.gltf", 32, 32, 256, 64, 2);
 }
 
 TEST_CASE("naive and mis converge to the same image: glass and mirror spheres") {

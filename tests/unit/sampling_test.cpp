@@ -239,4 +239,8 @@ TEST_CASE("power heuristic weights of two techniques sum to one") {
     for (float b : {0.01f, 1.0f, 7.0f}) CHECK(powerHeuristic(a, b) + powerHeuristic(b, a) == doctest::Approx(1.0f));
   CHECK(powerHeuristic(INFINITY, 3.0f) == 1.0f);
   CHECK(powerHeuristic(0.0f, 0.0f) == 0.0f);
+  // Pdfs whose square overflows a float (tiny lights, grazing angles) still give finite weights.
+  CHECK(powerHeuristic(1e20f, 1.0f) == 1.0f);
+  CHECK(powerHeuristic(1.0f, 1e20f) == doctest::Approx(0.0f));
+  CHECK(powerHeuristic(3e19f, 3e19f) == doctest::Approx(0.5f));
 }
