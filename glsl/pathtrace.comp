@@ -1,5 +1,5 @@
-// pathtrace.comp — the path tracer entry shader: one invocation per pixel, `options.y` samples per
-// dispatch, eye rays bounce until they reach emitters (naive) or also sample lights (CAUSTICA_MIS).
+// pathtrace.comp — the path tracer entry shader: one invocation per pixel and one sample per
+// dispatch; eye rays bounce until they reach emitters (naive) or also sample lights (CAUSTICA_MIS).
 // Radiance is linear; throughput is per RGB channel; wavelengths in nm.
 #include "lib/bindings.glsl"
 #include "lib/rng.glsl"
@@ -190,18 +190,16 @@ void main() {
   }
   memoryBarrierShared();
   barrier();
+  // One sample per invocation: more would run into llvmpipe's cap on nested loop iterations
+  // (see Renderer::renderRows); the host dispatches once per sample.
   uint primary = 0u, bad = 0u;
   if (valid) {
-    vec3 sum = vec3(0.0);
-    uint spp = frame.options.y;
-    for (uint i = 0u; i < spp; ++i) {
-      uint rng = rngSeed(pixel.y * frame.frame.x + pixel.x, frame.frame.z + i, frame.frame.w);
-      vec3 l = tracePath(pixel, rng);
-      ++primary;
-      if (any(isnan(l)) || any(isinf(l))) ++bad;  // never added to the image; counted
-      else sum += l;
-    }
-    accumulate(ivec2(pixel), sum, float(spp));
+    uint rng = rngSeed(pixel.y * frame.frame.x + pixel.x, frame.frame.z, frame.frame.w);
+    vec3 l = tracePath(pixel, rng);
+    primary = 1u;
+    bool finite = !(any(isnan(l)) || any(isinf(l)));
+    if (!finite) bad = 1u;  // never added to the image; counted
+    accumulate(ivec2(pixel), finite ? l : vec3(0.0), 1.0);
   }
   atomicAdd(groupCounts[0], primary);
   atomicAdd(groupCounts[1], gSecondaryRays);

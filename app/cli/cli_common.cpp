@@ -1,7 +1,10 @@
 // cli_common.cpp — option parsing and shared subcommand steps.
 #include "cli/cli_common.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -124,6 +127,32 @@ void parseSize(const std::string& text, float cameraAspect, int& width, int& hei
     width = num(text.substr(0, x));
     height = num(text.substr(x + 1));
   }
+}
+
+void renderWithProgress(Renderer& renderer, int targetSpp, const std::string& label, bool quiet) {
+  const auto start = std::chrono::steady_clock::now();
+  auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  const int first = renderer.samplesPerPixel();
+  int batch = 1;
+  double lastPrint = -1.0;
+  while (renderer.samplesPerPixel() < targetSpp) {
+    double t0 = seconds();
+    renderer.renderPass(std::min(batch, targetSpp - renderer.samplesPerPixel()));
+    double dt = seconds() - t0;
+    if (dt < 0.05 && batch < 256) batch *= 2;
+    else if (dt > 0.5 && batch > 1) batch /= 2;
+    double now = seconds();
+    int done = renderer.samplesPerPixel();
+    if (!quiet && (now - lastPrint > (tty ? 0.5 : 10.0) || done == targetSpp)) {
+      lastPrint = now;
+      double eta = now / (done - first) * (targetSpp - done);
+      std::fprintf(stderr, "%scaustica: %s%s%d/%d spp  %.1f s  eta %.1f s%s", tty ? "\r" : "", label.c_str(),
+                   label.empty() ? "" : " ", done, targetSpp, now, eta, tty ? "   " : "\n");
+      std::fflush(stderr);
+    }
+  }
+  if (!quiet && tty && renderer.samplesPerPixel() > first) std::fprintf(stderr, "\n");
 }
 
 void note(bool quiet, const std::string& line) {

@@ -56,6 +56,12 @@ LoadedScene loadSceneForCli(const Options& opts, bool verbose);
 RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth);
 ShaderLibrary shaderLibraryFrom(const Options& opts);
 
+// Renders until `renderer` holds `targetSpp` samples per pixel. Passes grow while they take under
+// 50 ms and shrink above 0.5 s, so progress stays live and no pass trips a GPU watchdog. Prints
+// "caustica: LABEL N/M spp" with the elapsed time and an estimate of what is left: in place on a
+// terminal, a line every 10 s in logs.
+void renderWithProgress(Renderer& renderer, int targetSpp, const std::string& label, bool quiet);
+
 // Prints a line to stderr with the "caustica: " prefix unless quiet.
 void note(bool quiet, const std::string& line);
 

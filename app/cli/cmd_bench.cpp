@@ -349,30 +349,11 @@ class Bench {
                        const RenderSettings& rs, const std::string& name, int referenceSpp, Reference& ref) {
     Renderer r(library, scene, camera, rs);
     const int half = referenceSpp / 2;
-    const int maxBatch = std::max(1, (1 << 26) / std::max(1, rs.width * rs.height));
-    auto start = Clock::now();
-    int batch = 1;
-    double lastPrint = -1.0;
+    const std::string label = "reference " + name + " " + dispersionModeName(rs.dispersion) + ":";
     // The first half, then the second: the sample indices differ, so the halves are independent.
-    while (r.samplesPerPixel() < referenceSpp) {
-      int target = r.samplesPerPixel() < half ? half : referenceSpp;
-      int n = std::min({batch, target - r.samplesPerPixel(), maxBatch});
-      auto t0 = Clock::now();
-      r.renderPass(n);
-      double dt = secondsSince(t0);
-      if (dt < 0.05 && batch < maxBatch) batch *= 2;
-      else if (dt > 0.5 && batch > 1) batch /= 2;
-      if (r.samplesPerPixel() == half) ref.halfA = r.image();
-      double now = secondsSince(start);
-      if (!quiet_ && (now - lastPrint > 1.0 || r.samplesPerPixel() == referenceSpp)) {
-        lastPrint = now;
-        double eta = now / r.samplesPerPixel() * (referenceSpp - r.samplesPerPixel());
-        std::fprintf(stderr, "\rcaustica: reference %s %s: %d/%d spp  %.0f s  eta %.0f s   ", name.c_str(),
-                     dispersionModeName(rs.dispersion), r.samplesPerPixel(), referenceSpp, now, eta);
-        std::fflush(stderr);
-      }
-    }
-    if (!quiet_) std::fprintf(stderr, "\n");
+    renderWithProgress(r, half, label, quiet_);
+    ref.halfA = r.image();
+    renderWithProgress(r, referenceSpp, label, quiet_);
     // mean = (A + B) / 2, so B = 2 mean - A.
     Image mean = r.image();
     Image b = mean;
@@ -397,7 +378,6 @@ class Bench {
     renderer.reset();
     const std::vector<double> schedule = checkpointSchedule(kFirstCheckpoint, maxSeconds_, kCheckpointsPerOctave);
     const double pixels = double(s.width) * s.height;
-    const int maxBatch = std::max(1, (1 << 26) / std::max(1, s.width * s.height));  // 32-bit GPU ray counters per dispatch
     double elapsed = 0.0;
     size_t next = 0;
     while (next < schedule.size()) {
@@ -405,7 +385,7 @@ class Bench {
       if (renderer.samplesPerPixel() > 0) {
         double sppPerSecond = renderer.samplesPerPixel() / elapsed;
         double wanted = std::ceil((schedule[next] - elapsed) * sppPerSecond);
-        double cap = std::max(1.0, std::min(double(maxBatch), std::floor(sppPerSecond * kMaxDispatchSeconds)));
+        double cap = std::max(1.0, std::floor(sppPerSecond * kMaxDispatchSeconds));
         n = static_cast<int>(std::clamp(wanted, 1.0, cap));
       }
       auto t0 = Clock::now();

@@ -1,6 +1,4 @@
 // cmd_render.cpp — `caustica render`: headless progressive render of a scene to an image file.
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -49,31 +47,9 @@ int cmdRender(const std::vector<std::string>& args) {
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
                   integratorName(settings.integrator));
 
-  // Samples per dispatch grow while a dispatch stays short, so progress and GPU watchdogs stay happy.
   auto start = std::chrono::steady_clock::now();
-  auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  int batch = 1;
-  double lastPrint = -1.0;
-  while (renderer.samplesPerPixel() < spp) {
-    int n = std::min(batch, spp - renderer.samplesPerPixel());
-    double t0 = seconds();
-    renderer.renderPass(n);
-    double dt = seconds() - t0;
-    if (dt < 0.05 && batch < 256) batch *= 2;
-    else if (dt > 0.5 && batch > 1) batch /= 2;
-    double now = seconds();
-    // On a terminal the progress line updates in place; in logs a line every 10 s.
-    if (!quiet && (now - lastPrint > (tty ? 0.5 : 10.0) || renderer.samplesPerPixel() == spp)) {
-      lastPrint = now;
-      double eta = now / renderer.samplesPerPixel() * (spp - renderer.samplesPerPixel());
-      std::fprintf(stderr, "%scaustica: %d/%d spp  %.1f s  eta %.1f s%s", tty ? "\r" : "", renderer.samplesPerPixel(),
-                   spp, now, eta, tty ? "   " : "\n");
-      std::fflush(stderr);
-    }
-  }
-  double total = seconds();
-  if (!quiet && tty) std::fprintf(stderr, "\n");
+  renderWithProgress(renderer, spp, "", quiet);
+  double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const RenderStats& st = renderer.stats();
   char line[256];
   std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s, non-finite samples: %llu", total,

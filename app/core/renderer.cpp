@@ -192,9 +192,15 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   // loops together (65535 from the outermost loop's start) and silently stops beyond; a per-sample
   // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
   // depend on how samples are split.
+  // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
+  // (a sample traces at most 2 * maxDepth + 1 rays).
+  const std::uint64_t raysPerDispatch =
+      static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0) * (2u * settings_.maxDepth + 1u);
+  const int dispatchesPerRead = static_cast<int>(std::max<std::uint64_t>(1, (1ull << 31) / raysPerDispatch));
   for (int s = 0; s < spp; ++s) {
+    if (s > 0 && s % dispatchesPerRead == 0) readCounters();
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, 1u, gpuScene_.emitters.size(),
+    fp.options = glm::uvec4(settings_.maxDepth, 0u, gpuScene_.emitters.size(),
                             (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
                                 (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
     frameUbo_.update(0, sizeof fp, &fp);

@@ -111,7 +111,7 @@ struct FrameParams {
   vec4 camUp;       // xyz: up axis scaled by tan(yfov/2)
   vec4 camForward;  // xyz: unit viewing direction
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
-  uvec4 options;    // x: max depth, y: samples per pixel in this dispatch, z: emitter count, w: kFlag* bits
+  uvec4 options;    // x: max depth, y: unused (one sample per dispatch), z: emitter count, w: kFlag* bits
   uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
   vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); y: exposure (display); zw unused
 };
