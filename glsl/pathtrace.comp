@@ -11,6 +11,9 @@
 #include "lib/spectral.glsl"
 #include "lib/materials.glsl"
 #include "lib/lights.glsl"
+#ifdef CAUSTICA_CASTERS
+#include "lib/casters.glsl"
+#endif
 #include "lib/accumulate.glsl"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
@@ -33,6 +36,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
   bool prevDelta = true;   // last direction came from the camera or a delta lobe: no MIS on emitter hits
   vec3 sigma = vec3(0.0);  // absorption coefficient of the medium the ray travels in (per scene unit)
   uint maxDepth = frame.options.x;
+  bool firstDiffuse = true;  // no diffuse vertex yet on this path
 
   for (uint depth = 0u; depth < maxDepth; ++depth) {
     if (depth > 0u) ++gSecondaryRays;
@@ -83,6 +87,18 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
     vec3 newDir;
     uint lobe = chooseLobe(m, rand01(rng));
     if (lobe == kLobeDiffuse) {
+#ifdef CAUSTICA_CASTERS
+      // Cosine sampling mixed with directions aimed at glass and mirror objects (casters.glsl): more
+      // paths reach the caustics they focus; the mixture pdf keeps the estimate unbiased and enters MIS.
+      // Only at the path's first diffuse vertex: the caustics the camera sees; deeper vertices gain
+      // little for the cost (measured in docs/benchmarks.md).
+      float uChoose = rand01(rng);
+      if (firstDiffuse) prepareCasters(p, ns, uChoose);
+      else gCasterUsable = 0u;
+      firstDiffuse = false;
+      float uPick = rand01(rng);
+      newDir = sampleDiffuseDirection(ns, uPick, rand2(rng));
+#endif
 #ifdef CAUSTICA_MIS
       // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
       // traced (not at the last vertex the depth limit allows), so both estimators end alike.
@@ -100,7 +116,12 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
           ++gShadowRays;
           // Stop just short of the light so its own triangle (and coplanar neighbours) do not occlude.
           if (!traceOccluded(offsetRayOrigin(p, ng), wl, dist * (1.0 - 1.0e-4))) {
-            float w = powerHeuristic(pdfLight, cosSurf * INV_PI);
+#ifdef CAUSTICA_CASTERS
+            float pdfBsdf = diffuseDirectionPdf(ns, wl);
+#else
+            float pdfBsdf = cosSurf * INV_PI;
+#endif
+            float w = powerHeuristic(pdfLight, pdfBsdf);
             vec3 transmittance = vec3(1.0);
 #ifdef CAUSTICA_VOLUME
             transmittance = exp(-sigma * dist);  // the shadow ray runs inside the same medium
@@ -110,6 +131,13 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
         }
       }
 #endif
+#ifdef CAUSTICA_CASTERS
+      float cosOut = dot(newDir, ns);
+      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) break;  // below the true surface: absorbed
+      float pdfDir = diffuseDirectionPdf(ns, newDir);
+      beta *= base.rgb * (cosOut * INV_PI / pdfDir);
+      prevPdf = pdfDir;
+#else
       vec3 t, b;
       orthonormalBasis(ns, t, b);
       vec3 local = sampleCosineHemisphere(rand2(rng));
@@ -118,6 +146,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
       if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) break;  // below the true surface: absorbed
       beta *= base.rgb;
       prevPdf = cosOut * INV_PI;
+#endif
       prevDelta = false;
     }
 #ifdef CAUSTICA_MIRROR

@@ -105,6 +105,8 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
       {"--dispersion", "", "MODE", "rgb (one channel per path; default) or spectral (hero wavelength)"},
       {"--max-depth", "", "N", "maximum path length in bounces (default 32)"},
+      {"--caster-probability", "", "P",
+       "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
       {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
@@ -179,6 +181,12 @@ LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
   return ls;
 }
 
+float casterProbabilityFrom(const Options& opts) {
+  double p = opts.getDouble("--caster-probability", 0.5);
+  if (!(p >= 0.0 && p <= 0.9)) throw Error("option --caster-probability needs a number from 0 to 0.9");
+  return static_cast<float>(p);
+}
+
 RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
   RenderSettings s;
   parseSize(opts.get("--size", std::to_string(defaultWidth)), camera.aspect, s.width, s.height);
@@ -186,6 +194,7 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
   s.maxDepth = opts.getInt("--max-depth", 32, 1, 1024);
   s.integrator = parseIntegrator(opts.get("--integrator", "mis"));
   s.dispersion = parseDispersionMode(opts.get("--dispersion", "rgb"));
+  s.casterProbability = casterProbabilityFrom(opts);
   return s;
 }
 

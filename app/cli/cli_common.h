@@ -53,6 +53,8 @@ struct LoadedScene {
 // Loads the scene argument (bare name or path) and picks --camera N (default 0; automatic if none).
 LoadedScene loadSceneForCli(const Options& opts, bool verbose);
 
+// --caster-probability, checked (0 to 0.9; default 0.5).
+float casterProbabilityFrom(const Options& opts);
 RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth);
 ShaderLibrary shaderLibraryFrom(const Options& opts);
 

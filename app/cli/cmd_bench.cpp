@@ -240,6 +240,7 @@ class Bench {
     parseSize(opts_.get("--size", "256"), camera.aspect, settings.width, settings.height);
     settings.seed = static_cast<std::uint32_t>(opts_.getInt("--seed", 1, 0, 2147483647));
     settings.maxDepth = opts_.getInt("--max-depth", 32, 1, 1024);
+    settings.casterProbability = casterProbabilityFrom(opts_);
 
     std::optional<PixelRect> caustic;
     auto info = sceneInfo_.find(name);
@@ -313,7 +314,7 @@ class Bench {
     std::ostringstream key;
     key << kCacheVersion << '\n' << hex64(hashSceneFiles(path)) << '\n' << rs.width << 'x' << rs.height << '\n'
         << referenceSpp << " spp\nseed " << rs.seed << "\ndepth " << rs.maxDepth << '\n'
-        << dispersionModeName(mode) << "\nmis\ncamera " << cameraIndex << ' ' << camera.position.x << ' '
+        << dispersionModeName(mode) << "\nmis\ncasters " << rs.casterProbability << "\ncamera " << cameraIndex << ' ' << camera.position.x << ' '
         << camera.position.y << ' ' << camera.position.z << ' ' << camera.forward.x << ' ' << camera.forward.y << ' '
         << camera.forward.z << ' ' << camera.up.x << ' ' << camera.up.y << ' ' << camera.up.z << ' ' << camera.yfov
         << '\n'
@@ -592,6 +593,8 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--gnuplot", "", "PROG", "gnuplot program that draws the plots (default gnuplot)"},
       {"--seed", "", "S", "random seed of the measured runs (default 1); the reference uses another"},
       {"--max-depth", "", "N", "maximum path length in bounces (default 32)"},
+      {"--caster-probability", "", "P",
+       "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
       {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},

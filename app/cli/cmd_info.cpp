@@ -64,6 +64,11 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
               bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
   std::printf("features:   %s\n", g.features.describe().c_str());
+  if (g.casters.empty()) std::printf("casters:    none (no glass or mirror object)\n");
+  for (size_t i = 0; i < g.casters.size(); ++i)
+    std::printf("%s %s sphere at %s, radius %.3g\n", i == 0 ? "casters:   " : "           ",
+                g.casters[i].refractive ? "glass " : "mirror", vec(glm::vec3(g.casters[i].sphere)).c_str(),
+                g.casters[i].sphere.w);
   std::string defines;
   for (const auto& d : g.features.defines()) defines += " " + d;
   std::printf("defines:   %s\n", defines.empty() ? " (none)" : defines.c_str());

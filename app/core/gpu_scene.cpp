@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "core/casters.h"
 #include "core/error.h"
 #include "core/sampling.h"
 
@@ -89,6 +90,8 @@ std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, co
 GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   GpuScene g;
   g.features = sceneFeatures(scene);
+  g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
+  g.emitterSphere = emitterBoundingSphere(scene);
   g.nodes = bvh.nodes;
   g.triGeom = packTriGeom(scene.triangles, bvh);
   g.triShade.resize(bvh.order.size());

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/bvh.h"
+#include "core/casters.h"
 #include "core/scene.h"
 
 namespace caustica {
@@ -28,6 +29,8 @@ struct GpuScene {
   std::vector<gpu::TexInfo> texInfo;
   float totalEmitterWeight = 0.0f;      // sum of luminance(emission) * area * sides
   double totalPower = 0.0;              // emitted power, pi * luminance * area * sides (scene units)
+  std::vector<CausticCaster> casters;   // caustic casters (findCausticCasters), at most CAUSTICA_MAX_CASTERS
+  glm::vec4 emitterSphere{0.0f, 0.0f, 0.0f, -1.0f};  // around every emitter (emitterBoundingSphere)
   SceneFeatures features;
 };
 

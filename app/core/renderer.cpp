@@ -1,6 +1,7 @@
 // renderer.cpp — scene upload, shader variants, dispatch and readback for the GPU path tracer.
 #include "core/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -60,6 +61,10 @@ void checkImageSize(const GlLimits& l, int w, int h) {
   if (gx > l.maxWorkGroupCount[0] || gy > l.maxWorkGroupCount[1]) throw Error("image too large for one compute dispatch");
 }
 
+void checkCasterProbability(float p) {
+  if (!(p >= 0.0f && p <= 0.9f)) throw Error("caster probability must be between 0 and 0.9");
+}
+
 }  // namespace
 
 Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
@@ -72,6 +77,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     throw Error("this GPU's compute work groups are too small");
   checkImageSize(limits_, settings_.width, settings_.height);
   if (settings_.maxDepth < 1 || settings_.maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
+  checkCasterProbability(settings_.casterProbability);
 
   auto t0 = std::chrono::steady_clock::now();
   bvh_ = buildBvh(scene.triangles);
@@ -101,13 +107,18 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   buffers_[CAUSTICA_BINDING_TEXINFO] = GlBuffer::fromVector(g.texInfo);
   buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
+  casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
+  uploadCasters();
   resize(settings_.width, settings_.height);
   program();  // compile now, so shader errors surface before rendering starts
 }
 
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
-  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) d.push_back("CAUSTICA_MIS");
+  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) {
+    d.push_back("CAUSTICA_MIS");
+    if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
+  }
   if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
 }
@@ -142,6 +153,26 @@ void Renderer::setMaxDepth(int maxDepth) {
   if (maxDepth < 1 || maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
   settings_.maxDepth = maxDepth;
   reset();
+}
+
+void Renderer::setCasterProbability(float p) {
+  checkCasterProbability(p);
+  settings_.casterProbability = p;
+  uploadCasters();
+  program();
+  reset();
+}
+
+void Renderer::uploadCasters() {
+  gpu::CasterParams cp{};
+  cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
+  cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, 0.0f, 0.0f);
+  cp.lights = gpuScene_.emitterSphere;
+  for (std::uint32_t i = 0; i < cp.count.x; ++i) {
+    cp.sphere[i] = gpuScene_.casters[i].sphere;
+    if (gpuScene_.casters[i].refractive) cp.count.y |= 1u << i;
+  }
+  casterUbo_.update(0, sizeof cp, &cp);
 }
 
 void Renderer::resize(int width, int height) {
@@ -186,6 +217,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   prog.use();
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
   frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
+  casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested

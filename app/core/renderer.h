@@ -30,6 +30,9 @@ struct RenderSettings {
   int maxDepth = 32;              // path segments
   Integrator integrator = Integrator::Mis;
   DispersionMode dispersion = DispersionMode::Rgb;
+  // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
+  // instead of cosine sampling; 0 turns it off. Below 1, so every direction keeps a non-zero pdf.
+  float casterProbability = 0.5f;
 };
 
 // Totals over everything rendered since the last reset.
@@ -57,6 +60,7 @@ class Renderer {
   void setIntegrator(Integrator integrator);     // restarts accumulation
   void setDispersionMode(DispersionMode mode);   // restarts accumulation
   void setMaxDepth(int maxDepth);                // restarts accumulation
+  void setCasterProbability(float p);            // restarts accumulation
   void resize(int width, int height);            // restarts accumulation
   void reset();
 
@@ -80,6 +84,7 @@ class Renderer {
  private:
   const GlProgram& program();
   void readCounters();
+  void uploadCasters();
 
   const ShaderLibrary& library_;
   RenderSettings settings_;
@@ -90,6 +95,7 @@ class Renderer {
   GlLimits limits_;
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
   GlBuffer frameUbo_;
+  GlBuffer casterUbo_;
   GlTexture accum_, comp_, display_;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;

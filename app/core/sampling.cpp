@@ -1,6 +1,7 @@
 // sampling.cpp — C++ twins of the shader sampling routines (see sampling.h).
 #include "core/sampling.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -111,6 +112,85 @@ glm::vec3 channelSensitivity(float lambdaNm) {
   const glm::vec3 mean(610.0f, 545.0f, 460.0f), sigma(30.0f, 30.0f, 22.0f);
   glm::vec3 x = (glm::vec3(lambdaNm) - mean) / sigma;
   return glm::exp(-0.5f * x * x) / (sigma * 2.50662827463f);
+}
+
+bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& cosMax,
+                float& oneMinusCos) {
+  glm::vec3 d = glm::vec3(sphere) - p;
+  float dist2 = glm::dot(d, d);
+  float r2 = sphere.w * sphere.w;
+  axis = glm::vec3(0.0f, 0.0f, 1.0f);
+  cosMax = 1.0f;
+  oneMinusCos = 0.0f;
+  if (!(dist2 > r2 * 1.0001f)) return false;
+  float dist = std::sqrt(dist2);
+  axis = d / dist;
+  float sin2 = r2 / dist2;
+  cosMax = std::sqrt(std::max(0.0f, 1.0f - sin2));
+  oneMinusCos = sin2 / (1.0f + cosMax);
+  return glm::dot(n, axis) > -std::sqrt(sin2);
+}
+
+glm::vec3 sampleUniformCone(const glm::vec3& axis, float oneMinusCos, const glm::vec2& u) {
+  float cosT = 1.0f - u.x * oneMinusCos;
+  float sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
+  float phi = 2.0f * kPi * u.y;
+  glm::vec3 t, b;
+  orthonormalBasis(axis, t, b);
+  return glm::normalize(sinT * std::cos(phi) * t + sinT * std::sin(phi) * b + cosT * axis);
+}
+
+bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float cosMax, const glm::vec4& lights, float margin) {
+  glm::vec3 d = glm::vec3(lights) - p;
+  float dist2 = glm::dot(d, d);
+  if (!(lights.w >= 0.0f)) return false;
+  if (dist2 <= lights.w * lights.w) return true;
+  float dist = std::sqrt(dist2);
+  float angleLights = std::asin(std::min(1.0f, lights.w / dist));
+  float between = std::acos(glm::clamp(glm::dot(axis, d / dist), -1.0f, 1.0f));
+  return between <= std::acos(glm::clamp(cosMax, -1.0f, 1.0f)) + angleLights + margin;
+}
+
+CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
+                            std::uint32_t refractMask, const glm::vec4& lights, float margin) {
+  CasterVertex v;
+  for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(CasterVertex::kMax) && i < count; ++i) {
+    glm::vec3 axis;
+    float cosMax, omc;
+    if (!casterCone(p, n, spheres[i], axis, cosMax, omc)) continue;
+    if ((refractMask & (1u << i)) != 0u && !casterFacesLights(p, axis, cosMax, lights, margin)) continue;
+    std::uint32_t k = v.usable++;
+    v.cone[k] = glm::vec4(axis, cosMax);
+    v.oneMinusCos[k] = omc;
+    v.invSolidAngle[k] = 1.0f / (2.0f * kPi * omc);
+    float keep = 1.0f / static_cast<float>(v.usable);
+    if (u < keep) {
+      v.pick = k;
+      u = u / keep;
+    } else {
+      u = (u - keep) / (1.0f - keep);
+    }
+  }
+  return v;
+}
+
+float diffuseDirectionPdf(const CasterVertex& v, float casterProbability, const glm::vec3& n, const glm::vec3& w) {
+  float cosPdf = std::max(glm::dot(n, w), 0.0f) / kPi;
+  if (v.usable == 0) return cosPdf;
+  float sum = 0.0f;
+  for (std::uint32_t k = 0; k < v.usable; ++k)
+    if (glm::dot(w, glm::vec3(v.cone[k])) >= v.cone[k].w) sum += v.invSolidAngle[k];
+  return (1.0f - casterProbability) * cosPdf + casterProbability * sum / static_cast<float>(v.usable);
+}
+
+glm::vec3 sampleDiffuseDirection(const CasterVertex& v, float casterProbability, const glm::vec3& n, float uPick,
+                                 const glm::vec2& u) {
+  if (v.usable > 0 && uPick < casterProbability)
+    return sampleUniformCone(glm::vec3(v.cone[v.pick]), v.oneMinusCos[v.pick], u);
+  glm::vec3 t, b;
+  orthonormalBasis(n, t, b);
+  glm::vec3 local = sampleCosineHemisphere(u);
+  return glm::normalize(local.x * t + local.y * b + local.z * n);
 }
 
 }  // namespace caustica

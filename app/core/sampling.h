@@ -26,4 +26,25 @@ glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n);
 float cauchyIor(float iorD, float abbe, float lambdaNm);
 glm::vec3 channelSensitivity(float lambdaNm);
 
+// Caustic-caster sampling (glsl/lib/casters.glsl). Spheres are xyz centre, w radius; directions unit,
+// world space; pdfs per steradian.
+bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& cosMax,
+                float& oneMinusCos);
+glm::vec3 sampleUniformCone(const glm::vec3& axis, float oneMinusCos, const glm::vec2& u);
+// The shader keeps this state in globals for the current diffuse vertex.
+struct CasterVertex {
+  static constexpr int kMax = 8;  // CAUSTICA_MAX_CASTERS
+  std::uint32_t usable = 0, pick = 0;
+  glm::vec4 cone[kMax];  // xyz axis, w cos of the half angle
+  float invSolidAngle[kMax];
+  float oneMinusCos[kMax];
+};
+bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float cosMax, const glm::vec4& lights, float margin);
+// refractMask bit i: spheres[i] refracts and is used only where casterFacesLights.
+CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
+                            std::uint32_t refractMask, const glm::vec4& lights, float margin);
+float diffuseDirectionPdf(const CasterVertex& v, float casterProbability, const glm::vec3& n, const glm::vec3& w);
+glm::vec3 sampleDiffuseDirection(const CasterVertex& v, float casterProbability, const glm::vec3& n, float uPick,
+                                 const glm::vec2& u);
+
 }  // namespace caustica

@@ -88,6 +88,7 @@ const std::vector<std::string>& shaderFeatureNames() {
       "CAUSTICA_TEXTURES",    // base-colour or emissive textures
       "CAUSTICA_OPACITY",     // base-colour alpha < 1
       "CAUSTICA_MIS",         // integrator: next-event estimation with MIS (else naive)
+      "CAUSTICA_CASTERS",     // mis: diffuse bounces also aim at glass and mirror objects
       "CAUSTICA_SPECTRAL",    // dispersion by hero wavelengths (else one RGB channel per path)
   };
   return names;

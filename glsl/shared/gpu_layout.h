@@ -28,6 +28,8 @@ using uint = std::uint32_t;
 #define CAUSTICA_BINDING_COUNTERS 7   // SSBO: Counters (atomic statistics)
 #define CAUSTICA_SSBO_COUNT 8         // SSBO bindings used by the path tracer
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
+#define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
+#define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_IMAGE_ACCUM 0        // image unit: rgba32f running sum of radiance
 #define CAUSTICA_IMAGE_COMP 1         // image unit: rgba32f Kahan compensation of the sum
 #define CAUSTICA_IMAGE_DISPLAY 2      // image unit: rgba8 tone-mapped display image
@@ -116,6 +118,17 @@ struct FrameParams {
   vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); y: exposure (display); zw unused
 };
 
+// Caustic casters: bounding spheres of the scene's specular objects (glass, mirrors), aimed at from
+// diffuse surfaces by the mis integrator so that caustic paths are found more often (std140).
+// A refractive caster is aimed at only from points that see it overlap the lights (within a margin):
+// the shadow side, where its caustic falls. Mirrors reflect light anywhere and are always aimed at.
+struct CasterParams {
+  uvec4 count;                            // x: spheres in use (0..CAUSTICA_MAX_CASTERS); y: bit i set = sphere i refracts; zw unused
+  vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians); zw unused
+  vec4 lights;                            // xyz: centre, w: radius of a sphere around every emitter (world space)
+  vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
@@ -125,6 +138,7 @@ static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
 static_assert(sizeof(TexInfo) == 16, "TexInfo must be 16 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
+static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
 }  // namespace caustica::gpu
 #endif
 #undef CAUSTICA_CONST

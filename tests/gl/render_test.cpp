@@ -32,7 +32,8 @@ struct BlockStats {
 };
 
 BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
-                      int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth) {
+                      int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth,
+                      float casterProbability = 0.5f) {
   BlockStats b;
   b.blocksX = w / block;
   b.blocksY = h / block;
@@ -41,6 +42,7 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
   for (int r = 0; r < renders; ++r) {
     RenderSettings settings = small(w, h, integrator, seedBase + r);
     settings.maxDepth = maxDepth;
+    settings.casterProbability = casterProbability;
     RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     for (int y = 0; y < b.blocksY * block; ++y)
@@ -58,15 +60,9 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
   return b;
 }
 
-// naive and mis must agree within noise: per block, |difference| within 4.5 standard errors (plus a
+// Two estimators must agree within noise: per block, |difference| within 4.5 standard errors (plus a
 // small relative slack for the variance estimate's own noise), and the image means within 1.5 %.
-void checkEstimatorsAgree(const std::string& scenePath, int w, int h, int sppNaive, int sppMis, int maxDepth = 32) {
-  Scene scene = loadScene(sourcePath(scenePath));
-  Camera cam = sceneCamera(scene);
-  std::uint64_t nonFinite = 0;
-  const int block = 8, renders = 8;
-  BlockStats a = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 100, &nonFinite, maxDepth);
-  BlockStats b = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 200, &nonFinite, maxDepth);
+void checkBlocksAgree(const std::string& what, const BlockStats& a, const BlockStats& b) {
   int bad = 0;
   double sumA = 0, sumB = 0;
   std::string worst;
@@ -81,9 +77,19 @@ void checkEstimatorsAgree(const std::string& scenePath, int w, int h, int sppNai
     sumA += a.mean[i];
     sumB += b.mean[i];
   }
-  INFO(scenePath, ": ", bad, " of ", a.mean.size(), " block channels disagree; e.g. ", worst);
+  INFO(what, ": ", bad, " of ", a.mean.size(), " block channels disagree; e.g. ", worst);
   CHECK(bad <= 1);  // one in ~200 may fall outside 4.5 sigma with an estimated variance
   CHECK(sumA / sumB == doctest::Approx(1.0).epsilon(0.015));
+}
+
+void checkEstimatorsAgree(const std::string& scenePath, int w, int h, int sppNaive, int sppMis, int maxDepth = 32) {
+  Scene scene = loadScene(sourcePath(scenePath));
+  Camera cam = sceneCamera(scene);
+  std::uint64_t nonFinite = 0;
+  const int block = 8, renders = 8;
+  BlockStats a = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 100, &nonFinite, maxDepth);
+  BlockStats b = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 200, &nonFinite, maxDepth);
+  checkBlocksAgree(scenePath, a, b);
   CHECK(nonFinite == 0);
 }
 
@@ -259,20 +265,45 @@ TEST_CASE("the refraction caustic appears under the glass sphere, brighter than 
   for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
     RenderResult r = renderScene(scene, cam, small(n, n, integ), 256);
     // Focus: the floor straight under the sphere (the ball lens images the small light there).
-    // Shadow: an annulus inside the sphere's shadow but outside the focus. Lit: open floor.
+    // Shadow: the outer ring of the sphere's shadow (radius about 0.4), past the spread of the
+    // focused light: converged (naive 4096 spp, mis 1024 spp) it is 0.3 x the lit floor; the ring
+    // nearer the focus (0.18-0.26) is 0.7 x, lit by the lens. Lit: open floor.
     double focus = 0;
     glm::ivec2 c = project(cam, glm::vec3(0.0f), n);
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx)
         for (int ch = 0; ch < 3; ++ch) focus += r.image.at(c.x + dx, c.y + dy, ch) / 27.0;
-    double shadow = floorAnnulus(r.image, cam, 0.18f, 0.26f, true);
+    double shadow = floorAnnulus(r.image, cam, 0.26f, 0.34f, true);
     double lit = floorAnnulus(r.image, cam, 0.6f, 0.9f, false);
     INFO(std::string(integratorName(integ)), ": focus ", focus, " shadow ", shadow, " lit ", lit);
     CHECK(lit > 0.02);
     CHECK(focus > 5.0 * lit);
-    CHECK(shadow < 0.2 * lit);
+    CHECK(shadow < 0.5 * lit);
     CHECK(r.stats.nonFinite == 0);
   }
+}
+
+TEST_CASE("mis aiming at the glass ball (caustic casters) matches naive and finds the caustic with less noise") {
+  Scene scene = causticScene(0.0f);
+  const Camera& cam = scene.cameras[0];
+  const int n = 32, block = 4, renders = 8;
+  std::uint64_t nonFinite = 0;
+  BlockStats naive = blockStats(scene, cam, Integrator::Naive, n, n, block, 256, renders, 300, &nonFinite, 32);
+  BlockStats aimed = blockStats(scene, cam, Integrator::Mis, n, n, block, 64, renders, 400, &nonFinite, 32, 0.5f);
+  BlockStats plain = blockStats(scene, cam, Integrator::Mis, n, n, block, 64, renders, 500, &nonFinite, 32, 0.0f);
+  checkBlocksAgree("caustic scene, naive against mis with casters", naive, aimed);
+  checkBlocksAgree("caustic scene, mis without casters against mis with casters", plain, aimed);
+  CHECK(nonFinite == 0);
+  // The focus under the ball: same samples per pixel, so the variance of the mean compares per sample.
+  glm::ivec2 c = project(cam, glm::vec3(0.0f), n) / block;
+  double varAimed = 0, varPlain = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    size_t i = (static_cast<size_t>(c.y) * aimed.blocksX + c.x) * 3 + ch;
+    varAimed += aimed.var[i];
+    varPlain += plain.var[i];
+  }
+  INFO("focus block variance: with casters ", varAimed, ", without ", varPlain);
+  CHECK(varAimed < 0.5 * varPlain);
 }
 
 TEST_CASE("rgb and spectral dispersion agree in mean brightness, and spread the caustic into colours") {

@@ -244,3 +244,90 @@ TEST_CASE("power heuristic weights of two techniques sum to one") {
   CHECK(powerHeuristic(1.0f, 1e20f) == doctest::Approx(0.0f));
   CHECK(powerHeuristic(3e19f, 3e19f) == doctest::Approx(0.5f));
 }
+
+TEST_CASE("uniform cone sampling: every direction inside, cos(theta) uniform over [cos max, 1]") {
+  glm::vec3 axis = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+  glm::vec4 sphere(glm::vec3(0.0f) + 2.0f * axis, 0.7f);  // seen from the origin
+  glm::vec3 a;
+  float cosMax = 0, omc = 0;
+  REQUIRE(casterCone(glm::vec3(0.0f), axis, sphere, a, cosMax, omc));
+  CHECK(glm::length(a - axis) < 1e-5f);
+  CHECK(cosMax == doctest::Approx(std::sqrt(1.0 - 0.49 / 4.0)).epsilon(1e-5));
+  CHECK(omc == doctest::Approx(1.0 - std::sqrt(1.0 - 0.49 / 4.0)).epsilon(1e-4));
+  const int bins = 16, n = 160000;
+  std::vector<double> obs(bins, 0), exp(bins, n / double(bins));
+  std::uint32_t s = 5;
+  for (int k = 0; k < n; ++k) {
+    glm::vec3 d = sampleUniformCone(a, omc, {rand01(s), rand01(s)});
+    float c = glm::dot(d, a);
+    REQUIRE(c >= cosMax - 1e-5f);
+    obs[std::min(bins - 1, static_cast<int>((1.0f - c) / omc * bins))]++;
+  }
+  int dof = 0;
+  double chi = chiSquare(obs, exp, dof);
+  CHECK(chi < chiSquareLimit(dof));
+}
+
+TEST_CASE("casters: inside a sphere or with the cone below the horizon a caster is not usable") {
+  glm::vec3 axis, n(0, 1, 0);
+  float c, omc;
+  CHECK_FALSE(casterCone(glm::vec3(0.0f), n, glm::vec4(0.1f, 0.0f, 0.0f, 0.5f), axis, c, omc));  // inside
+  CHECK_FALSE(casterCone(glm::vec3(0.0f), n, glm::vec4(0.0f, -2.0f, 0.0f, 0.5f), axis, c, omc));  // below
+  CHECK(casterCone(glm::vec3(0.0f), n, glm::vec4(2.0f, -0.4f, 0.0f, 0.5f), axis, c, omc));        // straddles
+}
+
+namespace {
+// Checks one diffuse vertex: the mixture pdf integrates to 1 over the sphere, and the sampler draws
+// from that pdf (E[g / pdf] = integral of g for g = cos/pi on the hemisphere and for g = cos/pi on
+// each usable cone, whose projected solid angle is known in closed form when above the horizon).
+void checkMixture(const glm::vec3& p, const glm::vec3& n, const std::vector<glm::vec4>& spheres, float a,
+                  std::uint32_t expectUsable) {
+  std::uint32_t s = 17;
+  CasterVertex v = prepareCasters(p, n, 0.5f, spheres.data(), static_cast<std::uint32_t>(spheres.size()), 0u, glm::vec4(0.0f), 0.0f);
+  REQUIRE(v.usable == expectUsable);
+  // Integral of the pdf over the sphere, by uniform directions.
+  const int m = 400000;
+  double integral = 0;
+  for (int k = 0; k < m; ++k) {
+    float z = 1.0f - 2.0f * rand01(s), phi = 2.0f * kPi * rand01(s), r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    integral += diffuseDirectionPdf(v, a, n, glm::vec3(r * std::cos(phi), r * std::sin(phi), z)) * 4.0 * kPi;
+  }
+  CHECK(integral / m == doctest::Approx(1.0).epsilon(0.01));
+  // Sampler against pdf. Picks are redrawn per sample, as in the shader.
+  double hemi = 0, cone0 = 0;
+  for (int k = 0; k < m; ++k) {
+    CasterVertex w = prepareCasters(p, n, rand01(s), spheres.data(), static_cast<std::uint32_t>(spheres.size()), 0u, glm::vec4(0.0f), 0.0f);
+    float uPick = rand01(s);
+    glm::vec3 d = sampleDiffuseDirection(w, a, n, uPick, {rand01(s), rand01(s)});
+    REQUIRE(std::abs(glm::length(d) - 1.0f) < 1e-4f);
+    float cosN = glm::dot(d, n);
+    if (cosN <= 0.0f) continue;
+    double pdf = diffuseDirectionPdf(w, a, n, d);
+    REQUIRE(pdf > 0.0);
+    hemi += cosN / kPi / pdf;
+    if (v.usable > 0 && glm::dot(d, glm::vec3(v.cone[0])) >= v.cone[0].w) cone0 += cosN / kPi / pdf;
+  }
+  CHECK(hemi / m == doctest::Approx(1.0).epsilon(0.01));
+  if (v.usable > 0) {
+    // Projected solid angle of a cone fully above the horizon: pi sin^2(half angle) cos(axis angle).
+    float sin2 = 1.0f - v.cone[0].w * v.cone[0].w;
+    float cosAxis = glm::dot(glm::vec3(v.cone[0]), n);
+    if (std::acos(cosAxis) + std::asin(std::sqrt(sin2)) < kPi / 2)
+      CHECK(cone0 / m == doctest::Approx(sin2 * cosAxis).epsilon(0.02));
+  }
+}
+}  // namespace
+
+TEST_CASE("diffuse directions mixed with caster cones: pdf integrates to 1 and matches the sampler") {
+  glm::vec3 n(0, 1, 0);
+  SUBCASE("no caster: pure cosine") { checkMixture(glm::vec3(0.0f), n, {}, 0.5f, 0); }
+  SUBCASE("one caster above") { checkMixture(glm::vec3(0.0f), n, {glm::vec4(0.3f, 0.7f, 0.1f, 0.3f)}, 0.5f, 1); }
+  SUBCASE("two overlapping casters and one straddling the horizon") {
+    checkMixture(glm::vec3(0.0f), n,
+                 {glm::vec4(0.3f, 0.7f, 0.1f, 0.3f), glm::vec4(0.45f, 0.8f, 0.1f, 0.25f), glm::vec4(2.0f, 0.1f, 0.0f, 0.4f)},
+                 0.7f, 3);
+  }
+  SUBCASE("a caster behind the surface is skipped") {
+    checkMixture(glm::vec3(0.0f), n, {glm::vec4(0.0f, -1.0f, 0.0f, 0.3f), glm::vec4(0.0f, 1.0f, 0.5f, 0.2f)}, 0.5f, 1);
+  }
+}

@@ -1,0 +1,105 @@
+// casters.glsl — diffuse bounce directions aimed at caustic casters (bounding spheres of glass and
+// mirror objects, CasterParams in gpu_layout.h) mixed with cosine sampling. Twins in app/core/sampling.h.
+// Directions are world-space unit vectors; pdfs are per steradian.
+
+layout(std140, binding = CAUSTICA_BINDING_CASTERS) uniform CasterBlock { CasterParams casters; };
+
+// The cone of directions from p towards sphere s (xyz centre, w radius): unit axis, cos of the half
+// angle and 1 - that cos (computed without cancellation). False when p is inside the sphere or the
+// whole cone lies below the plane of the unit normal n (no light can arrive from there).
+bool casterCone(vec3 p, vec3 n, vec4 s, out vec3 axis, out float cosMax, out float oneMinusCos) {
+  vec3 d = s.xyz - p;
+  float dist2 = dot(d, d);
+  float r2 = s.w * s.w;
+  axis = vec3(0.0, 0.0, 1.0);
+  cosMax = 1.0;
+  oneMinusCos = 0.0;
+  if (!(dist2 > r2 * 1.0001)) return false;
+  float dist = sqrt(dist2);
+  axis = d / dist;
+  float sin2 = r2 / dist2;
+  cosMax = sqrt(max(0.0, 1.0 - sin2));
+  oneMinusCos = sin2 / (1.0 + cosMax);
+  return dot(n, axis) > -sqrt(sin2);
+}
+
+// Whether the cone (unit axis, cos of the half angle) seen from p overlaps, within margin radians, the
+// cone of the sphere around every emitter: p lies roughly in the shadow the caster casts.
+bool casterFacesLights(vec3 p, vec3 axis, float cosMax, vec4 lights, float margin) {
+  vec3 d = lights.xyz - p;
+  float dist2 = dot(d, d);
+  if (!(lights.w >= 0.0)) return false;
+  if (dist2 <= lights.w * lights.w) return true;
+  float dist = sqrt(dist2);
+  float angleLights = asin(min(1.0, lights.w / dist));
+  float between = acos(clamp(dot(axis, d / dist), -1.0, 1.0));
+  return between <= acos(clamp(cosMax, -1.0, 1.0)) + angleLights + margin;
+}
+
+// Uniform direction in the cone about `axis` with 1 - cos(half angle) = oneMinusCos; pdf 1 / (2 pi oneMinusCos).
+vec3 sampleUniformCone(vec3 axis, float oneMinusCos, vec2 u) {
+  float cosT = 1.0 - u.x * oneMinusCos;
+  float sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
+  float phi = 2.0 * PI * u.y;
+  vec3 t, b;
+  orthonormalBasis(axis, t, b);
+  return normalize(sinT * cos(phi) * t + sinT * sin(phi) * b + cosT * axis);
+}
+
+// The cones of the casters usable from the current diffuse vertex (prepareCasters), kept for the
+// pdf evaluations that follow at the same vertex: usable ones first.
+uint gCasterUsable = 0u;                        // how many casters are usable from the vertex
+uint gCasterPick = 0u;                          // index into gCasterCone of the uniformly picked one
+vec4 gCasterCone[CAUSTICA_MAX_CASTERS];         // xyz: unit axis, w: cos of the half angle
+float gCasterInvSolidAngle[CAUSTICA_MAX_CASTERS];  // 1 / solid angle of the cone (per steradian)
+float gCasterOneMinusCos[CAUSTICA_MAX_CASTERS];    // 1 - cos of the half angle
+
+// Finds the casters usable from p (unit normal n) and picks one uniformly with u (a reservoir of one).
+void prepareCasters(vec3 p, vec3 n, float u) {
+  gCasterUsable = 0u;
+  gCasterPick = 0u;
+  for (uint i = 0u; i < uint(CAUSTICA_MAX_CASTERS); ++i) {
+    if (i >= casters.count.x) break;
+    vec3 axis;
+    float cosMax, omc;
+    if (!casterCone(p, n, casters.sphere[i], axis, cosMax, omc)) continue;
+    if ((casters.count.y & (1u << i)) != 0u && !casterFacesLights(p, axis, cosMax, casters.lights, casters.params.y))
+      continue;
+    uint k = gCasterUsable++;
+    gCasterCone[k] = vec4(axis, cosMax);
+    gCasterOneMinusCos[k] = omc;
+    gCasterInvSolidAngle[k] = 1.0 / (2.0 * PI * omc);
+    float keep = 1.0 / float(gCasterUsable);  // replace the current pick with probability 1/usable
+    if (u < keep) {
+      gCasterPick = k;
+      u = u / keep;
+    } else {
+      u = (u - keep) / (1.0 - keep);
+    }
+  }
+}
+
+// Density of sampleDiffuseDirection at w (per steradian): (1 - a) cos/pi + a * (mean over the usable
+// casters of [w in cone] / solid angle), a = casters.params.x when some caster is usable, else 0.
+float diffuseDirectionPdf(vec3 n, vec3 w) {
+  float cosPdf = max(dot(n, w), 0.0) * INV_PI;
+  if (gCasterUsable == 0u) return cosPdf;
+  float sum = 0.0;
+  for (uint k = 0u; k < uint(CAUSTICA_MAX_CASTERS); ++k) {
+    if (k >= gCasterUsable) break;
+    if (dot(w, gCasterCone[k].xyz) >= gCasterCone[k].w) sum += gCasterInvSolidAngle[k];
+  }
+  float a = casters.params.x;
+  return (1.0 - a) * cosPdf + a * sum / float(gCasterUsable);
+}
+
+// Diffuse bounce direction at the prepared vertex (unit normal n): with probability casters.params.x
+// (when a caster is usable) a uniform direction in the picked caster's cone, else a cosine-weighted one.
+vec3 sampleDiffuseDirection(vec3 n, float uPick, vec2 u) {
+  if (gCasterUsable > 0u && uPick < casters.params.x)
+    return sampleUniformCone(gCasterCone[gCasterPick].xyz, gCasterOneMinusCos[gCasterPick], u);
+  vec3 t, b;
+  orthonormalBasis(n, t, b);
+  vec3 local = sampleCosineHemisphere(u);
+  return normalize(local.x * t + local.y * b + local.z * n);
+}
