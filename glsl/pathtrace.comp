@@ -90,10 +90,10 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
 #ifdef CAUSTICA_CASTERS
       // Cosine sampling mixed with directions aimed at glass and mirror objects (casters.glsl): more
       // paths reach the caustics they focus; the mixture pdf keeps the estimate unbiased and enters MIS.
-      // Only at the path's first diffuse vertex: the caustics the camera sees; deeper vertices gain
-      // little for the cost (measured in docs/benchmarks.md).
+      // Only at the path's first diffuse vertex (the caustics the camera sees; deeper vertices gain
+      // less than they cost, docs/path-tracer.md), and not at the last vertex the depth limit allows.
       float uChoose = rand01(rng);
-      if (firstDiffuse) prepareCasters(p, ns, uChoose);
+      if (firstDiffuse && depth + 1u < maxDepth) prepareCasters(p, ns, uChoose);
       else gCasterUsable = 0u;
       firstDiffuse = false;
       float uPick = rand01(rng);

@@ -114,6 +114,11 @@ glm::vec3 channelSensitivity(float lambdaNm) {
   return glm::exp(-0.5f * x * x) / (sigma * 2.50662827463f);
 }
 
+bool inCone(const glm::vec3& w, const glm::vec3& axis, float oneMinusCos) {
+  glm::vec3 d = w - axis;
+  return 0.5f * glm::dot(d, d) <= oneMinusCos * 1.0001f;
+}
+
 bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& cosMax,
                 float& oneMinusCos) {
   glm::vec3 d = glm::vec3(sphere) - p;
@@ -128,12 +133,13 @@ bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere,
   float sin2 = r2 / dist2;
   cosMax = std::sqrt(std::max(0.0f, 1.0f - sin2));
   oneMinusCos = sin2 / (1.0f + cosMax);
-  return glm::dot(n, axis) > -std::sqrt(sin2);
+  return oneMinusCos >= kCasterMinOneMinusCos && glm::dot(n, axis) > -std::sqrt(sin2);
 }
 
 glm::vec3 sampleUniformCone(const glm::vec3& axis, float oneMinusCos, const glm::vec2& u) {
-  float cosT = 1.0f - u.x * oneMinusCos;
-  float sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
+  float omcT = u.x * oneMinusCos;
+  float cosT = 1.0f - omcT;
+  float sinT = std::sqrt(std::max(0.0f, omcT * (2.0f - omcT)));
   float phi = 2.0f * kPi * u.y;
   glm::vec3 t, b;
   orthonormalBasis(axis, t, b);
@@ -147,8 +153,9 @@ bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float cosMax, 
   if (dist2 <= lights.w * lights.w) return true;
   float dist = std::sqrt(dist2);
   float angleLights = std::asin(std::min(1.0f, lights.w / dist));
-  float between = std::acos(glm::clamp(glm::dot(axis, d / dist), -1.0f, 1.0f));
-  return between <= std::acos(glm::clamp(cosMax, -1.0f, 1.0f)) + angleLights + margin;
+  float angleCaster = std::asin(std::sqrt(std::max(0.0f, 1.0f - cosMax * cosMax)));
+  float between = 2.0f * std::asin(std::min(1.0f, 0.5f * glm::length(axis - d / dist)));
+  return between <= angleCaster + angleLights + margin;
 }
 
 CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
@@ -163,23 +170,17 @@ CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, con
     v.cone[k] = glm::vec4(axis, cosMax);
     v.oneMinusCos[k] = omc;
     v.invSolidAngle[k] = 1.0f / (2.0f * kPi * omc);
-    float keep = 1.0f / static_cast<float>(v.usable);
-    if (u < keep) {
-      v.pick = k;
-      u = u / keep;
-    } else {
-      u = (u - keep) / (1.0f - keep);
-    }
   }
+  if (v.usable > 0) v.pick = std::min(static_cast<std::uint32_t>(u * static_cast<float>(v.usable)), v.usable - 1);
   return v;
 }
 
 float diffuseDirectionPdf(const CasterVertex& v, float casterProbability, const glm::vec3& n, const glm::vec3& w) {
-  float cosPdf = std::max(glm::dot(n, w), 0.0f) / kPi;
+  float cosPdf = std::max(glm::dot(n, w), 0.0f) * kInvPi;
   if (v.usable == 0) return cosPdf;
   float sum = 0.0f;
   for (std::uint32_t k = 0; k < v.usable; ++k)
-    if (glm::dot(w, glm::vec3(v.cone[k])) >= v.cone[k].w) sum += v.invSolidAngle[k];
+    if (inCone(w, glm::vec3(v.cone[k]), v.oneMinusCos[k])) sum += v.invSolidAngle[k];
   return (1.0f - casterProbability) * cosPdf + casterProbability * sum / static_cast<float>(v.usable);
 }
 

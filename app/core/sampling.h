@@ -28,6 +28,9 @@ glm::vec3 channelSensitivity(float lambdaNm);
 
 // Caustic-caster sampling (glsl/lib/casters.glsl). Spheres are xyz centre, w radius; directions unit,
 // world space; pdfs per steradian.
+constexpr float kInvPi = 0.31830988618379067154f;
+constexpr float kCasterMinOneMinusCos = 1.0e-5f;  // narrowest cone aimed at: 1 - cos(half angle)
+bool inCone(const glm::vec3& w, const glm::vec3& axis, float oneMinusCos);
 bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& cosMax,
                 float& oneMinusCos);
 glm::vec3 sampleUniformCone(const glm::vec3& axis, float oneMinusCos, const glm::vec2& u);

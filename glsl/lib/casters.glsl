@@ -4,9 +4,21 @@
 
 layout(std140, binding = CAUSTICA_BINDING_CASTERS) uniform CasterBlock { CasterParams casters; };
 
+const float kCasterMinOneMinusCos = 1.0e-5;  // narrowest cone aimed at: 1 - cos(half angle)
+
+// Whether unit direction w lies in the cone (unit axis, 1 - cos of the half angle), tested as
+// 1 - cos(w, axis) = |w - axis|^2 / 2 without cancellation, with a relative slack of 1e-4 so that
+// directions sampled at the rim are never rounded out of it.
+bool inCone(vec3 w, vec3 axis, float oneMinusCos) {
+  vec3 d = w - axis;
+  return 0.5 * dot(d, d) <= oneMinusCos * 1.0001;
+}
+
 // The cone of directions from p towards sphere s (xyz centre, w radius): unit axis, cos of the half
-// angle and 1 - that cos (computed without cancellation). False when p is inside the sphere or the
-// whole cone lies below the plane of the unit normal n (no light can arrive from there).
+// angle and 1 - that cos (computed without cancellation). False when p is inside the sphere, the
+// whole cone lies below the plane of the unit normal n (no light can arrive from there), or the cone
+// is so narrow (half angle below ~0.26 degrees) that float rounding would blur which directions are
+// inside it: such a caster is not worth aiming at, and skipping it depends on p alone.
 bool casterCone(vec3 p, vec3 n, vec4 s, out vec3 axis, out float cosMax, out float oneMinusCos) {
   vec3 d = s.xyz - p;
   float dist2 = dot(d, d);
@@ -20,7 +32,7 @@ bool casterCone(vec3 p, vec3 n, vec4 s, out vec3 axis, out float cosMax, out flo
   float sin2 = r2 / dist2;
   cosMax = sqrt(max(0.0, 1.0 - sin2));
   oneMinusCos = sin2 / (1.0 + cosMax);
-  return dot(n, axis) > -sqrt(sin2);
+  return oneMinusCos >= kCasterMinOneMinusCos && dot(n, axis) > -sqrt(sin2);
 }
 
 // Whether the cone (unit axis, cos of the half angle) seen from p overlaps, within margin radians, the
@@ -32,14 +44,16 @@ bool casterFacesLights(vec3 p, vec3 axis, float cosMax, vec4 lights, float margi
   if (dist2 <= lights.w * lights.w) return true;
   float dist = sqrt(dist2);
   float angleLights = asin(min(1.0, lights.w / dist));
-  float between = acos(clamp(dot(axis, d / dist), -1.0, 1.0));
-  return between <= acos(clamp(cosMax, -1.0, 1.0)) + angleLights + margin;
+  float angleCaster = asin(sqrt(max(0.0, 1.0 - cosMax * cosMax)));
+  float between = 2.0 * asin(min(1.0, 0.5 * length(axis - d / dist)));  // exact for small angles, unlike acos
+  return between <= angleCaster + angleLights + margin;
 }
 
 // Uniform direction in the cone about `axis` with 1 - cos(half angle) = oneMinusCos; pdf 1 / (2 pi oneMinusCos).
 vec3 sampleUniformCone(vec3 axis, float oneMinusCos, vec2 u) {
-  float cosT = 1.0 - u.x * oneMinusCos;
-  float sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
+  float omcT = u.x * oneMinusCos;  // 1 - cos(theta), kept apart so narrow cones stay exact
+  float cosT = 1.0 - omcT;
+  float sinT = sqrt(max(0.0, omcT * (2.0 - omcT)));
   float phi = 2.0 * PI * u.y;
   vec3 t, b;
   orthonormalBasis(axis, t, b);
@@ -54,7 +68,7 @@ vec4 gCasterCone[CAUSTICA_MAX_CASTERS];         // xyz: unit axis, w: cos of the
 float gCasterInvSolidAngle[CAUSTICA_MAX_CASTERS];  // 1 / solid angle of the cone (per steradian)
 float gCasterOneMinusCos[CAUSTICA_MAX_CASTERS];    // 1 - cos of the half angle
 
-// Finds the casters usable from p (unit normal n) and picks one uniformly with u (a reservoir of one).
+// Finds the casters usable from p (unit normal n) and picks one of them uniformly with u.
 void prepareCasters(vec3 p, vec3 n, float u) {
   gCasterUsable = 0u;
   gCasterPick = 0u;
@@ -69,14 +83,8 @@ void prepareCasters(vec3 p, vec3 n, float u) {
     gCasterCone[k] = vec4(axis, cosMax);
     gCasterOneMinusCos[k] = omc;
     gCasterInvSolidAngle[k] = 1.0 / (2.0 * PI * omc);
-    float keep = 1.0 / float(gCasterUsable);  // replace the current pick with probability 1/usable
-    if (u < keep) {
-      gCasterPick = k;
-      u = u / keep;
-    } else {
-      u = (u - keep) / (1.0 - keep);
-    }
   }
+  if (gCasterUsable > 0u) gCasterPick = min(uint(u * float(gCasterUsable)), gCasterUsable - 1u);
 }
 
 // Density of sampleDiffuseDirection at w (per steradian): (1 - a) cos/pi + a * (mean over the usable
@@ -87,7 +95,7 @@ float diffuseDirectionPdf(vec3 n, vec3 w) {
   float sum = 0.0;
   for (uint k = 0u; k < uint(CAUSTICA_MAX_CASTERS); ++k) {
     if (k >= gCasterUsable) break;
-    if (dot(w, gCasterCone[k].xyz) >= gCasterCone[k].w) sum += gCasterInvSolidAngle[k];
+    if (inCone(w, gCasterCone[k].xyz, gCasterOneMinusCos[k])) sum += gCasterInvSolidAngle[k];
   }
   float a = casters.params.x;
   return (1.0 - a) * cosPdf + a * sum / float(gCasterUsable);

@@ -1,7 +1,9 @@
 // gl_test_util.h — helpers shared by the GPU tests: render a scene file or an in-memory scene and
 // get the linear image back, and per-region statistics.
 #pragma once
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "core/image_io.h"
 #include "core/renderer.h"
@@ -17,6 +19,7 @@ inline std::string sourcePath(const std::string& rel) { return std::string(CAUST
 struct RenderResult {
   Image image;
   RenderStats stats;
+  std::vector<std::string> defines;  // the shader variant that rendered it
 };
 
 inline RenderResult renderScene(const Scene& scene, const Camera& camera, RenderSettings settings, int spp,
@@ -24,7 +27,7 @@ inline RenderResult renderScene(const Scene& scene, const Camera& camera, Render
   static ShaderLibrary library;
   Renderer r(library, scene, camera, settings);
   while (r.samplesPerPixel() < spp) r.renderPass(std::min(sppPerPass, spp - r.samplesPerPixel()));
-  return {r.image(), r.stats()};
+  return {r.image(), r.stats(), r.shaderDefines()};
 }
 
 inline Camera sceneCamera(const Scene& s) { return s.cameras.empty() ? autoCamera(s.bounds) : s.cameras[0]; }

@@ -281,18 +281,25 @@ namespace {
 // from that pdf (E[g / pdf] = integral of g for g = cos/pi on the hemisphere and for g = cos/pi on
 // each usable cone, whose projected solid angle is known in closed form when above the horizon).
 void checkMixture(const glm::vec3& p, const glm::vec3& n, const std::vector<glm::vec4>& spheres, float a,
-                  std::uint32_t expectUsable) {
+                  std::uint32_t expectUsable, bool narrow = false) {
   std::uint32_t s = 17;
   CasterVertex v = prepareCasters(p, n, 0.5f, spheres.data(), static_cast<std::uint32_t>(spheres.size()), 0u, glm::vec4(0.0f), 0.0f);
   REQUIRE(v.usable == expectUsable);
-  // Integral of the pdf over the sphere, by uniform directions.
   const int m = 400000;
-  double integral = 0;
-  for (int k = 0; k < m; ++k) {
-    float z = 1.0f - 2.0f * rand01(s), phi = 2.0f * kPi * rand01(s), r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-    integral += diffuseDirectionPdf(v, a, n, glm::vec3(r * std::cos(phi), r * std::sin(phi), z)) * 4.0 * kPi;
+  if (!narrow) {  // integral of the pdf over the sphere, by uniform directions (too few hit a narrow cone)
+    double integral = 0;
+    for (int k = 0; k < m; ++k) {
+      float z = 1.0f - 2.0f * rand01(s), phi = 2.0f * kPi * rand01(s), r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      integral += diffuseDirectionPdf(v, a, n, glm::vec3(r * std::cos(phi), r * std::sin(phi), z)) * 4.0 * kPi;
+    }
+    CHECK(integral / m == doctest::Approx(1.0).epsilon(0.01));
   }
-  CHECK(integral / m == doctest::Approx(1.0).epsilon(0.01));
+  // Every direction drawn from a cone lies in it, even at the rim of a narrow cone.
+  for (std::uint32_t k = 0; k < v.usable; ++k)
+    for (int j = 0; j < 20000; ++j) {
+      glm::vec3 d = sampleUniformCone(glm::vec3(v.cone[k]), v.oneMinusCos[k], {rand01(s), rand01(s)});
+      REQUIRE(inCone(d, glm::vec3(v.cone[k]), v.oneMinusCos[k]));
+    }
   // Sampler against pdf. Picks are redrawn per sample, as in the shader.
   double hemi = 0, cone0 = 0;
   for (int k = 0; k < m; ++k) {
@@ -327,7 +334,55 @@ TEST_CASE("diffuse directions mixed with caster cones: pdf integrates to 1 and m
                  {glm::vec4(0.3f, 0.7f, 0.1f, 0.3f), glm::vec4(0.45f, 0.8f, 0.1f, 0.25f), glm::vec4(2.0f, 0.1f, 0.0f, 0.4f)},
                  0.7f, 3);
   }
+  SUBCASE("a narrow cone (half angle 0.4 degrees)") {
+    checkMixture(glm::vec3(0.0f), n, {glm::vec4(0.6f, 1.2f, 0.3f, 0.01f)}, 0.5f, 1, true);
+  }
+  SUBCASE("a cone too narrow to aim at (half angle 0.06 degrees) is skipped") {
+    checkMixture(glm::vec3(0.0f), n, {glm::vec4(0.0f, 3.0f, 0.0f, 0.003f)}, 0.5f, 0);
+  }
   SUBCASE("a caster behind the surface is skipped") {
     checkMixture(glm::vec3(0.0f), n, {glm::vec4(0.0f, -1.0f, 0.0f, 0.3f), glm::vec4(0.0f, 1.0f, 0.5f, 0.2f)}, 0.5f, 1);
   }
+}
+
+TEST_CASE("refractive casters are aimed at only from where they overlap the lights") {
+  glm::vec3 p(0.0f), n(0, 1, 0);
+  glm::vec4 lights(0.0f, 2.0f, 0.0f, 0.2f);
+  glm::vec4 above(0.0f, 1.0f, 0.0f, 0.1f), aside(1.0f, 0.5f, 0.0f, 0.1f), grazing(0.0f, 1.0f, 0.3f, 0.1f);
+  glm::vec3 axis;
+  float c, omc;
+  REQUIRE(casterCone(p, n, above, axis, c, omc));
+  CHECK(casterFacesLights(p, axis, c, lights, 0.0f));  // straight between p and the light
+  REQUIRE(casterCone(p, n, aside, axis, c, omc));
+  CHECK_FALSE(casterFacesLights(p, axis, c, lights, 0.0f));  // 63 degrees off the light
+  CHECK(casterFacesLights(p, axis, c, lights, 1.2f));          // unless the margin allows it
+  // Cone edges: the caster's half angle (5.7 deg) + the lights' (5.7 deg) against the angle between axes.
+  REQUIRE(casterCone(p, n, grazing, axis, c, omc));
+  float between = std::acos(glm::dot(axis, glm::vec3(0, 1, 0)));  // 16.7 deg
+  CHECK(between > std::asin(0.1f / glm::length(glm::vec3(grazing))) + std::asin(0.1f));
+  CHECK_FALSE(casterFacesLights(p, axis, c, lights, 0.0f));
+  CHECK(casterFacesLights(p, axis, c, lights, 0.1f));
+  CHECK(casterFacesLights(p, axis, c, glm::vec4(0.0f, 0.0f, 0.0f, 3.0f), 0.0f));   // p inside the lights' sphere
+  CHECK_FALSE(casterFacesLights(p, axis, c, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.0f));  // no emitters
+  // In prepareCasters the test applies to refractive casters (mask bit set) only.
+  glm::vec4 spheres[2] = {above, aside};
+  CHECK(prepareCasters(p, n, 0.5f, spheres, 2, 0u, lights, 0.0f).usable == 2);  // mirrors: both
+  CasterVertex v = prepareCasters(p, n, 0.9f, spheres, 2, 3u, lights, 0.0f);     // glass: only `above`
+  REQUIRE(v.usable == 1);
+  CHECK(glm::length(glm::vec3(v.cone[0]) - glm::vec3(0, 1, 0)) < 1e-5f);
+  CHECK(prepareCasters(p, n, 0.5f, spheres, 2, 2u, lights, 0.0f).usable == 1);  // `aside` glass, `above` mirror
+}
+
+TEST_CASE("the caster pick is uniform over the usable casters") {
+  glm::vec4 spheres[4] = {{0.0f, 1.0f, 0.0f, 0.1f}, {0.5f, 1.0f, 0.0f, 0.1f}, {0.0f, -1.0f, 0.0f, 0.1f}, {-0.5f, 1.0f, 0.0f, 0.1f}};
+  std::vector<double> obs(3, 0), exp(3, 30000.0 / 3);
+  std::uint32_t s = 3;
+  for (int k = 0; k < 30000; ++k) {
+    CasterVertex v = prepareCasters(glm::vec3(0.0f), glm::vec3(0, 1, 0), rand01(s), spheres, 4, 0u, glm::vec4(0.0f), 0.0f);
+    REQUIRE(v.usable == 3);  // the one below the surface is skipped
+    obs[v.pick]++;
+  }
+  int dof = 0;
+  double chi = chiSquare(obs, exp, dof);
+  CHECK(chi < chiSquareLimit(dof));
 }
