@@ -309,8 +309,12 @@ class Bench {
     rs.seed = kReferenceSeed;  // independent of the measured runs, whatever their --seed
     rs.integrator = Integrator::Mis;
     rs.dispersion = mode;
+    // The reference is one estimate of the image whatever the measured runs use: always mis with the
+    // default caster probability, so --caster-probability runs (ablations) share the cached reference.
+    rs.casterProbability = RenderSettings{}.casterProbability;
     renderer.setDispersionMode(mode);
     renderer.setIntegrator(Integrator::Mis);
+    renderer.setCasterProbability(rs.casterProbability);
     std::ostringstream key;
     key << kCacheVersion << '\n' << hex64(hashSceneFiles(path)) << '\n' << rs.width << 'x' << rs.height << '\n'
         << referenceSpp << " spp\nseed " << rs.seed << "\ndepth " << rs.maxDepth << '\n'
@@ -319,6 +323,7 @@ class Bench {
         << camera.forward.z << ' ' << camera.up.x << ' ' << camera.up.y << ' ' << camera.up.z << ' ' << camera.yfov
         << '\n'
         << hex64(fnv1a64(library.expand("pathtrace.comp", renderer.shaderDefines()).source)) << '\n';
+    renderer.setCasterProbability(settings.casterProbability);
     std::string stem = name + "-" + dispersionModeName(mode) + "-" + hex64(fnv1a64(key.str()));
     fs::path a = fs::path(cacheDir_) / (stem + "-a.exr"), b = fs::path(cacheDir_) / (stem + "-b.exr");
     std::error_code ec;
