@@ -375,6 +375,10 @@ class Bench {
     RunResult out;
     out.scene = name;
     out.integrator = integratorName(s.integrator);
+    // A non-default caster probability is part of the estimator's name (CSV, plot, summary).
+    if (s.integrator == Integrator::Mis && !renderer.gpuScene().casters.empty() &&
+        s.casterProbability != RenderSettings{}.casterProbability)
+      out.integrator += fmt(" casters=%g", s.casterProbability);
     out.dispersion = dispersionModeName(s.dispersion);
     out.noise = ref.noise;
     out.noiseCaustic = ref.noiseCaustic;
@@ -545,12 +549,13 @@ class Bench {
     // mis against naive at the same scene and dispersion mode: the ratio of efficiencies.
     std::ostringstream cmp;
     for (const auto& m : all_) {
-      if (m.integrator != "mis") continue;
+      if (m.integrator.rfind("mis", 0) != 0) continue;
       for (const auto& n : all_) {
         if (n.integrator != "naive" || n.scene != m.scene || n.dispersion != m.dispersion) continue;
         const BenchRow &a = m.rows.back(), &b = n.rows.back();
         double whole = efficiency(a.relMse, a.seconds) / efficiency(b.relMse, b.seconds);
-        cmp << "- " << m.scene << (m.dispersion == "rgb" ? "" : " (" + m.dispersion + ")") << ": mis/naive efficiency "
+        cmp << "- " << m.scene << (m.dispersion == "rgb" ? "" : " (" + m.dispersion + ")") << ": " << m.integrator
+            << "/naive efficiency "
             << fmt("%.2fx", whole) << " whole image";
         if (m.hasCaustic)
           cmp << ", " << fmt("%.2fx", efficiency(a.relMseCaustic, a.seconds) / efficiency(b.relMseCaustic, b.seconds))
