@@ -35,6 +35,7 @@ const char* kControls =
     "  F                    toggle fly mode (left drag looks around instead of orbiting)\n"
     "  R                    reset to the scene camera\n"
     "  I                    integrator: mis / naive\n"
+    "  C                    mis: caster aiming (bounces aimed at glass and mirrors) on / off\n"
     "  L                    dispersion: rgb / spectral (hero wavelength)\n"
     "  [ ]                  max depth down / up\n"
     "  + -  (0)             exposure +/- 0.5 stop (reset)\n"
@@ -108,6 +109,8 @@ class Viewer {
 
   // What the renderer should be doing (applied by syncRenderer, which pausing defers).
   Integrator integrator_ = Integrator::Mis;
+  float casterProbability_ = RenderSettings{}.casterProbability;
+  float casterProbabilityOn_ = RenderSettings{}.casterProbability;  // what C switches back to
   DispersionMode dispersion_ = DispersionMode::Rgb;
   int maxDepth_ = 32;
   int fullW_ = 0, fullH_ = 0;          // full render resolution, pixels
@@ -156,6 +159,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config) : config_(config) 
   sceneName_ = fileStem(scene_.scene.path);
   RenderSettings settings = renderSettingsFrom(opts, scene_.camera, kDefaultWidth);
   integrator_ = settings.integrator;
+  casterProbability_ = settings.casterProbability;
+  if (casterProbability_ > 0.0f) casterProbabilityOn_ = casterProbability_;
   dispersion_ = settings.dispersion;
   maxDepth_ = settings.maxDepth;
   exposure0_ = config_.tone.exposureStops;
@@ -198,6 +203,14 @@ void Viewer::handleInput(double dt) {
       case GLFW_KEY_R: controller_->reset(); break;
       case GLFW_KEY_F: fly_ = !fly_; break;
       case GLFW_KEY_I: integrator_ = integrator_ == Integrator::Mis ? Integrator::Naive : Integrator::Mis; break;
+      case GLFW_KEY_C:
+        if (casterProbability_ > 0.0f) {
+          casterProbabilityOn_ = casterProbability_;
+          casterProbability_ = 0.0f;
+        } else {
+          casterProbability_ = casterProbabilityOn_;
+        }
+        break;
       case GLFW_KEY_L:
         dispersion_ = dispersion_ == DispersionMode::Rgb ? DispersionMode::Spectral : DispersionMode::Rgb;
         break;
@@ -269,6 +282,11 @@ void Viewer::syncRenderer() {
   const RenderSettings& s = renderer_->settings();
   if (s.integrator != integrator_) {
     renderer_->setIntegrator(integrator_);
+    warmUp();
+    restarted = true;
+  }
+  if (s.casterProbability != casterProbability_) {
+    renderer_->setCasterProbability(casterProbability_);
     warmUp();
     restarted = true;
   }
@@ -450,7 +468,11 @@ void Viewer::updateTitle(bool force) {
   lastTitle_ = t;
   std::string title = "caustica view - " + sceneName_ + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
                       format("%.3g samples/s", samplesPerSecond_) + " | " + format("%.1f ms/frame", frameMs_) + " | " +
-                      integratorName(integrator_) + " | " + dispersionModeName(dispersion_) + " | depth " +
+                      integratorName(integrator_) +
+                      (integrator_ == Integrator::Mis && !renderer_->gpuScene().casters.empty()
+                           ? (casterProbability_ > 0.0f ? " + casters" : " no casters")
+                           : "") +
+                      " | " + dispersionModeName(dispersion_) + " | depth " +
                       std::to_string(maxDepth_) + " | " + format("exposure %+.1f", config_.tone.exposureStops) +
                       " | non-finite " + std::to_string(renderer_->stats().nonFinite);
   if (previewing_) title += " | preview 1/" + std::to_string(previewScale_);
