@@ -114,6 +114,12 @@ std::vector<OptionSpec> sceneOptionSpecs() {
   };
 }
 
+OptionSpec sceneOptionSpec(const std::string& name) {
+  for (const OptionSpec& s : sceneOptionSpecs())
+    if (s.name == name) return s;
+  throw Error("internal: no scene option " + name);
+}
+
 void parseSize(const std::string& text, float cameraAspect, int& width, int& height) {
   size_t x = text.find('x');
   auto num = [&](const std::string& s) {
@@ -182,9 +188,13 @@ LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
 }
 
 float casterProbabilityFrom(const Options& opts) {
-  double p = opts.getDouble("--caster-probability", 0.5);
-  if (!(p >= 0.0 && p <= 0.9)) throw Error("option --caster-probability needs a number from 0 to 0.9");
-  return static_cast<float>(p);
+  float p = static_cast<float>(opts.getDouble("--caster-probability", RenderSettings{}.casterProbability));
+  if (!(p >= 0.0f && p <= kMaxCasterProbability)) {
+    std::ostringstream m;
+    m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
+    throw Error(m.str());
+  }
+  return p;
 }
 
 RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {

@@ -42,6 +42,8 @@ class Options {
 
 // Options shared by render, view and bench.
 std::vector<OptionSpec> sceneOptionSpecs();
+// The entry of sceneOptionSpecs() named `name` (for commands that take only some of them).
+OptionSpec sceneOptionSpec(const std::string& name);
 
 // Parses "W" or "WxH". With only W, H follows the camera's aspect ratio (or is W).
 void parseSize(const std::string& text, float cameraAspect, int& width, int& height);

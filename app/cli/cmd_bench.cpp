@@ -273,9 +273,10 @@ class Bench {
           reference(library, scene, camera, settings, renderer, path, name, cameraIndex, mode, caustic, referenceSpp);
       std::string preview = (fs::path(outDir_) / (name + "-" + dispersionModeName(mode) + "-reference.png")).string();
       writeImage(preview, caustic ? outlined(ref.image, *caustic, 4.0f) : ref.image);
-      for (Integrator integrator : integrators_) {
+      for (Integrator integrator : integrators_) {  // reference() left the renderer in its own settings
         renderer.setDispersionMode(mode);
         renderer.setIntegrator(integrator);
+        renderer.setCasterProbability(settings.casterProbability);
         results.push_back(measure(renderer, name, ref, caustic));
       }
     }
@@ -323,7 +324,6 @@ class Bench {
         << camera.forward.z << ' ' << camera.up.x << ' ' << camera.up.y << ' ' << camera.up.z << ' ' << camera.yfov
         << '\n'
         << hex64(fnv1a64(library.expand("pathtrace.comp", renderer.shaderDefines()).source)) << '\n';
-    renderer.setCasterProbability(settings.casterProbability);
     std::string stem = name + "-" + dispersionModeName(mode) + "-" + hex64(fnv1a64(key.str()));
     fs::path a = fs::path(cacheDir_) / (stem + "-a.exr"), b = fs::path(cacheDir_) / (stem + "-b.exr");
     std::error_code ec;
@@ -602,12 +602,11 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--scenes-json", "", "FILE", "caustic regions per scene (default: the bundled bench/scenes.json)"},
       {"--gnuplot", "", "PROG", "gnuplot program that draws the plots (default gnuplot)"},
       {"--seed", "", "S", "random seed of the measured runs (default 1); the reference uses another"},
-      {"--max-depth", "", "N", "maximum path length in bounces (default 32)"},
-      {"--caster-probability", "", "P",
-       "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
-      {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
-      {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
-      {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
+      sceneOptionSpec("--max-depth"),
+      sceneOptionSpec("--caster-probability"),
+      sceneOptionSpec("--camera"),
+      sceneOptionSpec("--backend"),
+      sceneOptionSpec("--shader-dir"),
       {"--quiet", "-q", "", "print nothing but errors and the summary table"},
   };
   Options opts("caustica bench [SCENE...] [options]",

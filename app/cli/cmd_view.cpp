@@ -203,14 +203,7 @@ void Viewer::handleInput(double dt) {
       case GLFW_KEY_R: controller_->reset(); break;
       case GLFW_KEY_F: fly_ = !fly_; break;
       case GLFW_KEY_I: integrator_ = integrator_ == Integrator::Mis ? Integrator::Naive : Integrator::Mis; break;
-      case GLFW_KEY_C:
-        if (casterProbability_ > 0.0f) {
-          casterProbabilityOn_ = casterProbability_;
-          casterProbability_ = 0.0f;
-        } else {
-          casterProbability_ = casterProbabilityOn_;
-        }
-        break;
+      case GLFW_KEY_C: casterProbability_ = casterProbability_ > 0.0f ? 0.0f : casterProbabilityOn_; break;
       case GLFW_KEY_L:
         dispersion_ = dispersion_ == DispersionMode::Rgb ? DispersionMode::Spectral : DispersionMode::Rgb;
         break;

@@ -89,14 +89,8 @@ double referenceNoise(const Image& halfA, const Image& halfB) {
 double referenceNoise(const Image& halfA, const Image& halfB, const PixelRect& region) {
   checkSameSize(halfA, halfB, "reference noise");
   checkRegion(halfA, region, "reference noise");
-  double sum = 0.0;
-  for (int y = region.y0; y < region.y1; ++y)
-    for (int x = region.x0; x < region.x1; ++x)
-      for (int c = 0; c < 3; ++c) {
-        double a = halfA.at(x, y, c), b = halfB.at(x, y, c), m = 0.5 * (a + b), d = a - b;
-        sum += d * d / (m * m + kRelMseEpsilon);
-      }
-  return sum / (3.0 * region.width() * region.height()) / 4.0;
+  // A - M = (A - B) / 2, so mean((A - B)^2 / (M^2 + eps)) / 4 is the relMSE of A against M.
+  return relMse(halfA, averageImages(halfA, halfB), region);
 }
 
 Image averageImages(const Image& a, const Image& b) {

@@ -74,15 +74,15 @@ std::vector<CausticCaster> findCausticCasters(const Scene& scene, int maxCasters
       if (!inserted) uf.unite(k, it->second);
     }
   std::unordered_map<std::uint32_t, std::vector<glm::vec3>> components;
+  std::unordered_map<std::uint32_t, bool> refractive;
   for (std::uint32_t k = 0; k < tris.size(); ++k) {
-    auto& pts = components[uf.find(k)];
-    for (const glm::vec3& p : scene.triangles[tris[k]].p) pts.push_back(p);
+    std::uint32_t root = uf.find(k);
+    const Triangle& t = scene.triangles[tris[k]];
+    components[root].insert(components[root].end(), std::begin(t.p), std::end(t.p));
+    refractive[root] |= scene.materials[t.material].transmission > 0.0f;
   }
 
   float diagonal = scene.bounds.empty() ? 0.0f : glm::length(scene.bounds.max - scene.bounds.min);
-  std::unordered_map<std::uint32_t, bool> refractive;
-  for (std::uint32_t k = 0; k < tris.size(); ++k)
-    refractive[uf.find(k)] |= scene.materials[scene.triangles[tris[k]].material].transmission > 0.0f;
   struct Object {
     glm::vec4 sphere;
     bool refractive;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 #include "core/error.h"
 
@@ -62,7 +63,11 @@ void checkImageSize(const GlLimits& l, int w, int h) {
 }
 
 void checkCasterProbability(float p) {
-  if (!(p >= 0.0f && p <= 0.9f)) throw Error("caster probability must be between 0 and 0.9");
+  if (!(p >= 0.0f && p <= kMaxCasterProbability)) {
+    std::ostringstream m;
+    m << "caster probability must be between 0 and " << kMaxCasterProbability;
+    throw Error(m.str());
+  }
 }
 
 }  // namespace

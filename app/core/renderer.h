@@ -31,9 +31,11 @@ struct RenderSettings {
   Integrator integrator = Integrator::Mis;
   DispersionMode dispersion = DispersionMode::Rgb;
   // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
-  // instead of cosine sampling; 0 turns it off. Below 1, so every direction keeps a non-zero pdf.
+  // instead of cosine sampling; 0 turns it off. At most kMaxCasterProbability, so every direction
+  // keeps a non-zero pdf.
   float casterProbability = 0.5f;
 };
+constexpr float kMaxCasterProbability = 0.9f;
 
 // Totals over everything rendered since the last reset.
 struct RenderStats {

@@ -119,20 +119,17 @@ bool inCone(const glm::vec3& w, const glm::vec3& axis, float oneMinusCos) {
   return 0.5f * glm::dot(d, d) <= oneMinusCos * 1.0001f;
 }
 
-bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& cosMax,
-                float& oneMinusCos) {
+bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& oneMinusCos) {
   glm::vec3 d = glm::vec3(sphere) - p;
   float dist2 = glm::dot(d, d);
   float r2 = sphere.w * sphere.w;
   axis = glm::vec3(0.0f, 0.0f, 1.0f);
-  cosMax = 1.0f;
   oneMinusCos = 0.0f;
   if (!(dist2 > r2 * 1.0001f)) return false;
   float dist = std::sqrt(dist2);
   axis = d / dist;
   float sin2 = r2 / dist2;
-  cosMax = std::sqrt(std::max(0.0f, 1.0f - sin2));
-  oneMinusCos = sin2 / (1.0f + cosMax);
+  oneMinusCos = sin2 / (1.0f + std::sqrt(std::max(0.0f, 1.0f - sin2)));
   return oneMinusCos >= kCasterMinOneMinusCos && glm::dot(n, axis) > -std::sqrt(sin2);
 }
 
@@ -146,14 +143,15 @@ glm::vec3 sampleUniformCone(const glm::vec3& axis, float oneMinusCos, const glm:
   return glm::normalize(sinT * std::cos(phi) * t + sinT * std::sin(phi) * b + cosT * axis);
 }
 
-bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float cosMax, const glm::vec4& lights, float margin) {
+bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float oneMinusCos, const glm::vec4& lights,
+                       float margin) {
   glm::vec3 d = glm::vec3(lights) - p;
   float dist2 = glm::dot(d, d);
   if (!(lights.w >= 0.0f)) return false;
   if (dist2 <= lights.w * lights.w) return true;
   float dist = std::sqrt(dist2);
   float angleLights = std::asin(std::min(1.0f, lights.w / dist));
-  float angleCaster = std::asin(std::sqrt(std::max(0.0f, 1.0f - cosMax * cosMax)));
+  float angleCaster = std::asin(std::sqrt(oneMinusCos * (2.0f - oneMinusCos)));
   float between = 2.0f * std::asin(std::min(1.0f, 0.5f * glm::length(axis - d / dist)));
   return between <= angleCaster + angleLights + margin;
 }
@@ -163,11 +161,11 @@ CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, con
   CasterVertex v;
   for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(CasterVertex::kMax) && i < count; ++i) {
     glm::vec3 axis;
-    float cosMax, omc;
-    if (!casterCone(p, n, spheres[i], axis, cosMax, omc)) continue;
-    if ((refractMask & (1u << i)) != 0u && !casterFacesLights(p, axis, cosMax, lights, margin)) continue;
+    float omc;
+    if (!casterCone(p, n, spheres[i], axis, omc)) continue;
+    if ((refractMask & (1u << i)) != 0u && !casterFacesLights(p, axis, omc, lights, margin)) continue;
     std::uint32_t k = v.usable++;
-    v.cone[k] = glm::vec4(axis, cosMax);
+    v.axis[k] = axis;
     v.oneMinusCos[k] = omc;
     v.invSolidAngle[k] = 1.0f / (2.0f * kPi * omc);
   }
@@ -180,14 +178,14 @@ float diffuseDirectionPdf(const CasterVertex& v, float casterProbability, const 
   if (v.usable == 0) return cosPdf;
   float sum = 0.0f;
   for (std::uint32_t k = 0; k < v.usable; ++k)
-    if (inCone(w, glm::vec3(v.cone[k]), v.oneMinusCos[k])) sum += v.invSolidAngle[k];
+    if (inCone(w, v.axis[k], v.oneMinusCos[k])) sum += v.invSolidAngle[k];
   return (1.0f - casterProbability) * cosPdf + casterProbability * sum / static_cast<float>(v.usable);
 }
 
 glm::vec3 sampleDiffuseDirection(const CasterVertex& v, float casterProbability, const glm::vec3& n, float uPick,
                                  const glm::vec2& u) {
   if (v.usable > 0 && uPick < casterProbability)
-    return sampleUniformCone(glm::vec3(v.cone[v.pick]), v.oneMinusCos[v.pick], u);
+    return sampleUniformCone(v.axis[v.pick], v.oneMinusCos[v.pick], u);
   glm::vec3 t, b;
   orthonormalBasis(n, t, b);
   glm::vec3 local = sampleCosineHemisphere(u);

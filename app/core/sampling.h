@@ -31,18 +31,18 @@ glm::vec3 channelSensitivity(float lambdaNm);
 constexpr float kInvPi = 0.31830988618379067154f;
 constexpr float kCasterMinOneMinusCos = 1.0e-5f;  // narrowest cone aimed at: 1 - cos(half angle)
 bool inCone(const glm::vec3& w, const glm::vec3& axis, float oneMinusCos);
-bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& cosMax,
-                float& oneMinusCos);
+bool casterCone(const glm::vec3& p, const glm::vec3& n, const glm::vec4& sphere, glm::vec3& axis, float& oneMinusCos);
 glm::vec3 sampleUniformCone(const glm::vec3& axis, float oneMinusCos, const glm::vec2& u);
 // The shader keeps this state in globals for the current diffuse vertex.
 struct CasterVertex {
   static constexpr int kMax = 8;  // CAUSTICA_MAX_CASTERS
   std::uint32_t usable = 0, pick = 0;
-  glm::vec4 cone[kMax];  // xyz axis, w cos of the half angle
+  glm::vec3 axis[kMax];  // unit axis of the cone
   float invSolidAngle[kMax];
   float oneMinusCos[kMax];
 };
-bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float cosMax, const glm::vec4& lights, float margin);
+bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float oneMinusCos, const glm::vec4& lights,
+                       float margin);
 // refractMask bit i: spheres[i] refracts and is used only where casterFacesLights.
 CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
                             std::uint32_t refractMask, const glm::vec4& lights, float margin);

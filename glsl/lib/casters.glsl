@@ -14,37 +14,35 @@ bool inCone(vec3 w, vec3 axis, float oneMinusCos) {
   return 0.5 * dot(d, d) <= oneMinusCos * 1.0001;
 }
 
-// The cone of directions from p towards sphere s (xyz centre, w radius): unit axis, cos of the half
-// angle and 1 - that cos (computed without cancellation). False when p is inside the sphere, the
+// The cone of directions from p towards sphere s (xyz centre, w radius): unit axis and 1 - cos of the
+// half angle (computed without cancellation). False when p is inside the sphere, the
 // whole cone lies below the plane of the unit normal n (no light can arrive from there), or the cone
 // is so narrow (half angle below ~0.26 degrees) that float rounding would blur which directions are
 // inside it: such a caster is not worth aiming at, and skipping it depends on p alone.
-bool casterCone(vec3 p, vec3 n, vec4 s, out vec3 axis, out float cosMax, out float oneMinusCos) {
+bool casterCone(vec3 p, vec3 n, vec4 s, out vec3 axis, out float oneMinusCos) {
   vec3 d = s.xyz - p;
   float dist2 = dot(d, d);
   float r2 = s.w * s.w;
   axis = vec3(0.0, 0.0, 1.0);
-  cosMax = 1.0;
   oneMinusCos = 0.0;
   if (!(dist2 > r2 * 1.0001)) return false;
   float dist = sqrt(dist2);
   axis = d / dist;
   float sin2 = r2 / dist2;
-  cosMax = sqrt(max(0.0, 1.0 - sin2));
-  oneMinusCos = sin2 / (1.0 + cosMax);
+  oneMinusCos = sin2 / (1.0 + sqrt(max(0.0, 1.0 - sin2)));
   return oneMinusCos >= kCasterMinOneMinusCos && dot(n, axis) > -sqrt(sin2);
 }
 
-// Whether the cone (unit axis, cos of the half angle) seen from p overlaps, within margin radians, the
-// cone of the sphere around every emitter: p lies roughly in the shadow the caster casts.
-bool casterFacesLights(vec3 p, vec3 axis, float cosMax, vec4 lights, float margin) {
+// Whether the cone (unit axis, 1 - cos of the half angle) seen from p overlaps, within margin radians,
+// the cone of the sphere around every emitter: p lies roughly in the shadow the caster casts.
+bool casterFacesLights(vec3 p, vec3 axis, float oneMinusCos, vec4 lights, float margin) {
   vec3 d = lights.xyz - p;
   float dist2 = dot(d, d);
   if (!(lights.w >= 0.0)) return false;
   if (dist2 <= lights.w * lights.w) return true;
   float dist = sqrt(dist2);
   float angleLights = asin(min(1.0, lights.w / dist));
-  float angleCaster = asin(sqrt(max(0.0, 1.0 - cosMax * cosMax)));
+  float angleCaster = asin(sqrt(oneMinusCos * (2.0 - oneMinusCos)));  // sin^2 = (1 - cos)(1 + cos)
   float between = 2.0 * asin(min(1.0, 0.5 * length(axis - d / dist)));  // exact for small angles, unlike acos
   return between <= angleCaster + angleLights + margin;
 }
@@ -63,8 +61,8 @@ vec3 sampleUniformCone(vec3 axis, float oneMinusCos, vec2 u) {
 // The cones of the casters usable from the current diffuse vertex (prepareCasters), kept for the
 // pdf evaluations that follow at the same vertex: usable ones first.
 uint gCasterUsable = 0u;                        // how many casters are usable from the vertex
-uint gCasterPick = 0u;                          // index into gCasterCone of the uniformly picked one
-vec4 gCasterCone[CAUSTICA_MAX_CASTERS];         // xyz: unit axis, w: cos of the half angle
+uint gCasterPick = 0u;                          // index into gCasterAxis of the uniformly picked one
+vec3 gCasterAxis[CAUSTICA_MAX_CASTERS];         // unit axis of the cone
 float gCasterInvSolidAngle[CAUSTICA_MAX_CASTERS];  // 1 / solid angle of the cone (per steradian)
 float gCasterOneMinusCos[CAUSTICA_MAX_CASTERS];    // 1 - cos of the half angle
 
@@ -75,12 +73,12 @@ void prepareCasters(vec3 p, vec3 n, float u) {
   for (uint i = 0u; i < uint(CAUSTICA_MAX_CASTERS); ++i) {
     if (i >= casters.count.x) break;
     vec3 axis;
-    float cosMax, omc;
-    if (!casterCone(p, n, casters.sphere[i], axis, cosMax, omc)) continue;
-    if ((casters.count.y & (1u << i)) != 0u && !casterFacesLights(p, axis, cosMax, casters.lights, casters.params.y))
+    float omc;
+    if (!casterCone(p, n, casters.sphere[i], axis, omc)) continue;
+    if ((casters.count.y & (1u << i)) != 0u && !casterFacesLights(p, axis, omc, casters.lights, casters.params.y))
       continue;
     uint k = gCasterUsable++;
-    gCasterCone[k] = vec4(axis, cosMax);
+    gCasterAxis[k] = axis;
     gCasterOneMinusCos[k] = omc;
     gCasterInvSolidAngle[k] = 1.0 / (2.0 * PI * omc);
   }
@@ -95,7 +93,7 @@ float diffuseDirectionPdf(vec3 n, vec3 w) {
   float sum = 0.0;
   for (uint k = 0u; k < uint(CAUSTICA_MAX_CASTERS); ++k) {
     if (k >= gCasterUsable) break;
-    if (inCone(w, gCasterCone[k].xyz, gCasterOneMinusCos[k])) sum += gCasterInvSolidAngle[k];
+    if (inCone(w, gCasterAxis[k], gCasterOneMinusCos[k])) sum += gCasterInvSolidAngle[k];
   }
   float a = casters.params.x;
   return (1.0 - a) * cosPdf + a * sum / float(gCasterUsable);
@@ -105,7 +103,7 @@ float diffuseDirectionPdf(vec3 n, vec3 w) {
 // (when a caster is usable) a uniform direction in the picked caster's cone, else a cosine-weighted one.
 vec3 sampleDiffuseDirection(vec3 n, float uPick, vec2 u) {
   if (gCasterUsable > 0u && uPick < casters.params.x)
-    return sampleUniformCone(gCasterCone[gCasterPick].xyz, gCasterOneMinusCos[gCasterPick], u);
+    return sampleUniformCone(gCasterAxis[gCasterPick], gCasterOneMinusCos[gCasterPick], u);
   vec3 t, b;
   orthonormalBasis(n, t, b);
   vec3 local = sampleCosineHemisphere(u);

@@ -249,8 +249,9 @@ TEST_CASE("uniform cone sampling: every direction inside, cos(theta) uniform ove
   glm::vec3 axis = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
   glm::vec4 sphere(glm::vec3(0.0f) + 2.0f * axis, 0.7f);  // seen from the origin
   glm::vec3 a;
-  float cosMax = 0, omc = 0;
-  REQUIRE(casterCone(glm::vec3(0.0f), axis, sphere, a, cosMax, omc));
+  float omc = 0;
+  REQUIRE(casterCone(glm::vec3(0.0f), axis, sphere, a, omc));
+  float cosMax = 1.0f - omc;
   CHECK(glm::length(a - axis) < 1e-5f);
   CHECK(cosMax == doctest::Approx(std::sqrt(1.0 - 0.49 / 4.0)).epsilon(1e-5));
   CHECK(omc == doctest::Approx(1.0 - std::sqrt(1.0 - 0.49 / 4.0)).epsilon(1e-4));
@@ -270,10 +271,10 @@ TEST_CASE("uniform cone sampling: every direction inside, cos(theta) uniform ove
 
 TEST_CASE("casters: inside a sphere or with the cone below the horizon a caster is not usable") {
   glm::vec3 axis, n(0, 1, 0);
-  float c, omc;
-  CHECK_FALSE(casterCone(glm::vec3(0.0f), n, glm::vec4(0.1f, 0.0f, 0.0f, 0.5f), axis, c, omc));  // inside
-  CHECK_FALSE(casterCone(glm::vec3(0.0f), n, glm::vec4(0.0f, -2.0f, 0.0f, 0.5f), axis, c, omc));  // below
-  CHECK(casterCone(glm::vec3(0.0f), n, glm::vec4(2.0f, -0.4f, 0.0f, 0.5f), axis, c, omc));        // straddles
+  float omc;
+  CHECK_FALSE(casterCone(glm::vec3(0.0f), n, glm::vec4(0.1f, 0.0f, 0.0f, 0.5f), axis, omc));  // inside
+  CHECK_FALSE(casterCone(glm::vec3(0.0f), n, glm::vec4(0.0f, -2.0f, 0.0f, 0.5f), axis, omc));  // below
+  CHECK(casterCone(glm::vec3(0.0f), n, glm::vec4(2.0f, -0.4f, 0.0f, 0.5f), axis, omc));        // straddles
 }
 
 namespace {
@@ -297,8 +298,8 @@ void checkMixture(const glm::vec3& p, const glm::vec3& n, const std::vector<glm:
   // Every direction drawn from a cone lies in it, even at the rim of a narrow cone.
   for (std::uint32_t k = 0; k < v.usable; ++k)
     for (int j = 0; j < 20000; ++j) {
-      glm::vec3 d = sampleUniformCone(glm::vec3(v.cone[k]), v.oneMinusCos[k], {rand01(s), rand01(s)});
-      REQUIRE(inCone(d, glm::vec3(v.cone[k]), v.oneMinusCos[k]));
+      glm::vec3 d = sampleUniformCone(v.axis[k], v.oneMinusCos[k], {rand01(s), rand01(s)});
+      REQUIRE(inCone(d, v.axis[k], v.oneMinusCos[k]));
     }
   // Sampler against pdf. Picks are redrawn per sample, as in the shader.
   double hemi = 0, cone0 = 0;
@@ -312,13 +313,13 @@ void checkMixture(const glm::vec3& p, const glm::vec3& n, const std::vector<glm:
     double pdf = diffuseDirectionPdf(w, a, n, d);
     REQUIRE(pdf > 0.0);
     hemi += cosN / kPi / pdf;
-    if (v.usable > 0 && glm::dot(d, glm::vec3(v.cone[0])) >= v.cone[0].w) cone0 += cosN / kPi / pdf;
+    if (v.usable > 0 && inCone(d, v.axis[0], v.oneMinusCos[0])) cone0 += cosN / kPi / pdf;
   }
   CHECK(hemi / m == doctest::Approx(1.0).epsilon(0.01));
   if (v.usable > 0) {
     // Projected solid angle of a cone fully above the horizon: pi sin^2(half angle) cos(axis angle).
-    float sin2 = 1.0f - v.cone[0].w * v.cone[0].w;
-    float cosAxis = glm::dot(glm::vec3(v.cone[0]), n);
+    float sin2 = v.oneMinusCos[0] * (2.0f - v.oneMinusCos[0]);
+    float cosAxis = glm::dot(v.axis[0], n);
     if (std::acos(cosAxis) + std::asin(std::sqrt(sin2)) < kPi / 2)
       CHECK(cone0 / m == doctest::Approx(sin2 * cosAxis).epsilon(0.02));
   }
@@ -350,26 +351,26 @@ TEST_CASE("refractive casters are aimed at only from where they overlap the ligh
   glm::vec4 lights(0.0f, 2.0f, 0.0f, 0.2f);
   glm::vec4 above(0.0f, 1.0f, 0.0f, 0.1f), aside(1.0f, 0.5f, 0.0f, 0.1f), grazing(0.0f, 1.0f, 0.3f, 0.1f);
   glm::vec3 axis;
-  float c, omc;
-  REQUIRE(casterCone(p, n, above, axis, c, omc));
-  CHECK(casterFacesLights(p, axis, c, lights, 0.0f));  // straight between p and the light
-  REQUIRE(casterCone(p, n, aside, axis, c, omc));
-  CHECK_FALSE(casterFacesLights(p, axis, c, lights, 0.0f));  // 63 degrees off the light
-  CHECK(casterFacesLights(p, axis, c, lights, 1.2f));          // unless the margin allows it
+  float omc;
+  REQUIRE(casterCone(p, n, above, axis, omc));
+  CHECK(casterFacesLights(p, axis, omc, lights, 0.0f));  // straight between p and the light
+  REQUIRE(casterCone(p, n, aside, axis, omc));
+  CHECK_FALSE(casterFacesLights(p, axis, omc, lights, 0.0f));  // 63 degrees off the light
+  CHECK(casterFacesLights(p, axis, omc, lights, 1.2f));          // unless the margin allows it
   // Cone edges: the caster's half angle (5.7 deg) + the lights' (5.7 deg) against the angle between axes.
-  REQUIRE(casterCone(p, n, grazing, axis, c, omc));
+  REQUIRE(casterCone(p, n, grazing, axis, omc));
   float between = std::acos(glm::dot(axis, glm::vec3(0, 1, 0)));  // 16.7 deg
   CHECK(between > std::asin(0.1f / glm::length(glm::vec3(grazing))) + std::asin(0.1f));
-  CHECK_FALSE(casterFacesLights(p, axis, c, lights, 0.0f));
-  CHECK(casterFacesLights(p, axis, c, lights, 0.1f));
-  CHECK(casterFacesLights(p, axis, c, glm::vec4(0.0f, 0.0f, 0.0f, 3.0f), 0.0f));   // p inside the lights' sphere
-  CHECK_FALSE(casterFacesLights(p, axis, c, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.0f));  // no emitters
+  CHECK_FALSE(casterFacesLights(p, axis, omc, lights, 0.0f));
+  CHECK(casterFacesLights(p, axis, omc, lights, 0.1f));
+  CHECK(casterFacesLights(p, axis, omc, glm::vec4(0.0f, 0.0f, 0.0f, 3.0f), 0.0f));   // p inside the lights' sphere
+  CHECK_FALSE(casterFacesLights(p, axis, omc, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.0f));  // no emitters
   // In prepareCasters the test applies to refractive casters (mask bit set) only.
   glm::vec4 spheres[2] = {above, aside};
   CHECK(prepareCasters(p, n, 0.5f, spheres, 2, 0u, lights, 0.0f).usable == 2);  // mirrors: both
   CasterVertex v = prepareCasters(p, n, 0.9f, spheres, 2, 3u, lights, 0.0f);     // glass: only `above`
   REQUIRE(v.usable == 1);
-  CHECK(glm::length(glm::vec3(v.cone[0]) - glm::vec3(0, 1, 0)) < 1e-5f);
+  CHECK(glm::length(v.axis[0] - glm::vec3(0, 1, 0)) < 1e-5f);
   CHECK(prepareCasters(p, n, 0.5f, spheres, 2, 2u, lights, 0.0f).usable == 1);  // `aside` glass, `above` mirror
 }
 
