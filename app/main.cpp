@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "core/error.h"
+#include "util/error.h"
 
 namespace {
 

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "core/bvh.h"
-#include "core/obj_mesh.h"
-#include "core/error.h"
+#include "accel/bvh.h"
+#include "scene/obj_mesh.h"
+#include "util/error.h"
 
 using namespace caustica;
 
@@ -26,14 +26,6 @@ const char* kUsage =
     "several (bins, maxLeafSize) settings and prints build time, Mtris/s, SAH cost, nodes, leaves,\n"
     "depth and single-thread traceClosest speed on random rays (times are CPU time; builds best of\n"
     "several). --csv FILE also writes the table.\n";
-
-Triangle makeTri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
-  Triangle t{};
-  t.p[0] = a;
-  t.p[1] = b;
-  t.p[2] = c;
-  return t;
-}
 
 
 // UV sphere of radius ~1 with a bumpy displacement: 2 * nu * (nv - 1) triangles (one per pole cell).
@@ -49,8 +41,8 @@ std::vector<Triangle> displacedSphere(int nu, int nv) {
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
       const glm::vec3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1), d = point(i, j + 1);
-      if (j > 0) tris.push_back(makeTri(a, b, c));
-      if (j < nv - 1) tris.push_back(makeTri(a, c, d));
+      if (j > 0) tris.push_back(makeTriangle(a, b, c));
+      if (j < nv - 1) tris.push_back(makeTriangle(a, c, d));
     }
   return tris;
 }

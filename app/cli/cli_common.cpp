@@ -11,8 +11,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "core/assets.h"
-#include "core/error.h"
+#include "scene/assets.h"
+#include "util/error.h"
 
 namespace caustica::cli {
 

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "core/gl_context.h"
-#include "core/renderer.h"
-#include "core/scene.h"
-#include "core/shader_library.h"
+#include "platform/gl_context.h"
+#include "gpu/renderer.h"
+#include "scene/scene.h"
+#include "gpu/shader_library.h"
 
 namespace caustica::cli {
 

@@ -19,10 +19,11 @@
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
-#include "core/assets.h"
-#include "core/bench_metrics.h"
-#include "core/error.h"
-#include "core/image_io.h"
+#include "scene/assets.h"
+#include "cli/bench/bench_metrics.h"
+#include "util/error.h"
+#include "util/file_io.h"
+#include "image/image_io.h"
 #include "platform/context.h"
 
 extern char** environ;
@@ -44,14 +45,6 @@ constexpr double kMaxDispatchSeconds = 0.1;  // longest single dispatch we aim f
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string readFileBytes(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(path + ": cannot read");
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 std::vector<std::string> splitList(const std::string& text) {
   std::vector<std::string> out;
@@ -98,7 +91,7 @@ std::string defaultCacheDir() {
 
 // Hash of the scene file and of the files it names (external glTF buffers and images).
 std::uint64_t hashSceneFiles(const std::string& path) {
-  std::string bytes = readFileBytes(path);
+  std::string bytes = readFileText(path);
   std::uint64_t h = fnv1a64(bytes);
   if (fileExtension(path) != ".gltf") return h;
   try {
@@ -111,7 +104,7 @@ std::uint64_t hashSceneFiles(const std::string& path) {
         if (uri.rfind("data:", 0) == 0) continue;
         fs::path p = fs::path(path).parent_path() / uri;
         std::error_code ec;
-        if (fs::is_regular_file(p, ec)) h = fnv1a64(readFileBytes(p.string()), fnv1a64(uri, h));
+        if (fs::is_regular_file(p, ec)) h = fnv1a64(readFileText(p.string()), fnv1a64(uri, h));
       }
     }
   } catch (const nlohmann::json::exception&) {
@@ -191,7 +184,7 @@ class Bench {
     for (const auto& name : splitList(opts.get("--dispersion", "rgb,spectral"))) dispersions_.push_back(parseDispersionMode(name));
     if (dispersions_.empty()) throw Error("option --dispersion needs at least one of rgb, spectral");
     std::string scenesJson = findScenesJson(opts);
-    if (!scenesJson.empty()) sceneInfo_ = parseBenchScenes(readFileBytes(scenesJson), scenesJson);
+    if (!scenesJson.empty()) sceneInfo_ = parseBenchScenes(readFileText(scenesJson), scenesJson);
     else note(quiet_, "warning: bench/scenes.json not found: no caustic regions (use --scenes-json FILE)");
     std::error_code ec;
     fs::create_directories(outDir_, ec);

@@ -6,9 +6,9 @@
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
-#include "core/bvh.h"
-#include "core/error.h"
-#include "core/gpu_scene.h"
+#include "accel/bvh.h"
+#include "util/error.h"
+#include "accel/gpu_scene.h"
 
 namespace caustica::cli {
 

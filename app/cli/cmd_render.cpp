@@ -6,8 +6,8 @@
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
-#include "core/error.h"
-#include "core/image_io.h"
+#include "util/error.h"
+#include "image/image_io.h"
 #include "platform/context.h"
 
 namespace caustica::cli {

@@ -11,9 +11,9 @@
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
-#include "core/camera_controller.h"
-#include "core/error.h"
-#include "core/image_io.h"
+#include "cli/view/camera_controller.h"
+#include "util/error.h"
+#include "image/image_io.h"
 
 #ifdef CAUSTICA_HAVE_GLFW
 #define GLFW_INCLUDE_NONE

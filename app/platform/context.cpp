@@ -3,7 +3,7 @@
 
 #include <glad/gl.h>
 
-#include "core/error.h"
+#include "util/error.h"
 
 namespace caustica {
 

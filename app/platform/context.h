@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "core/gl_context.h"
+#include "platform/gl_context.h"
 
 namespace caustica {
 

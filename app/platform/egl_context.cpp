@@ -7,7 +7,7 @@
 #include <cstring>
 #include <vector>
 
-#include "core/error.h"
+#include "util/error.h"
 #include "platform/context.h"
 
 namespace caustica {

@@ -7,7 +7,7 @@
 
 #include <cstdlib>
 
-#include "core/error.h"
+#include "util/error.h"
 
 namespace caustica {
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "core/gl_context.h"
+#include "platform/gl_context.h"
 
 struct GLFWwindow;
 

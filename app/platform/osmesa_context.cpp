@@ -6,7 +6,7 @@
 
 #include <array>
 
-#include "core/error.h"
+#include "util/error.h"
 #include "platform/context.h"
 
 namespace caustica {

@@ -1,0 +1,485 @@
+// bvh.cpp — binned-SAH BVH builder (flattened to 32-byte gpu::BvhNode) and the C++ twins of the
+// GLSL ray–triangle test (intersect.glsl) and stack traversal (traverse.glsl). All positions and
+// distances are in world space; t is measured in units of |ray.dir|.
+#include "accel/bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "util/error.h"
+
+namespace caustica {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// Deepest level a leaf may have (root = 1). Near-child-first traversal pushes at most one entry per
+// level below the root, so a tree of depth <= this never needs more than CAUSTICA_BVH_STACK - 2 entries.
+constexpr int kMaxLeafDepth = CAUSTICA_BVH_STACK - 1;
+constexpr int kMaxBins = 64;
+
+// 4-wide float vector (GCC/Clang vector extension, compiled to SSE/NEON): lanes x, y, z, unused.
+typedef float F4 __attribute__((vector_size(16)));
+typedef std::int32_t I4 __attribute__((vector_size(16)));
+inline F4 splat(float x) { return F4{x, x, x, x}; }
+inline F4 vmin(F4 a, F4 b) { return a < b ? a : b; }
+inline F4 vmax(F4 a, F4 b) { return a > b ? a : b; }
+
+// Axis-aligned box in world space. An empty box has lo = +inf, hi = -inf, which grow() treats as neutral.
+struct Box {
+  F4 lo = splat(kInf);
+  F4 hi = splat(-kInf);
+  void grow(const Box& b) {
+    lo = vmin(lo, b.lo);
+    hi = vmax(hi, b.hi);
+  }
+  void grow(F4 p) {
+    lo = vmin(lo, p);
+    hi = vmax(hi, p);
+  }
+  // Half the surface area, in double so that huge coordinates cannot overflow. Box must not be empty.
+  double halfArea() const {
+    const double dx = double(hi[0]) - lo[0], dy = double(hi[1]) - lo[1], dz = double(hi[2]) - lo[2];
+    return dx * dy + dy * dz + dz * dx;
+  }
+};
+
+// Build-time primitive (32 bytes): the finite bounds of one input triangle in lanes 0-2; its index
+// split into two 16-bit halves stored as exact small floats in the 4th lanes (never used as geometry).
+struct Prim {
+  Box box;
+  Prim(const Box& b, std::uint32_t index) : box(b) {
+    box.lo[3] = float(index & 0xffffu);
+    box.hi[3] = float(index >> 16);
+  }
+  std::uint32_t index() const { return std::uint32_t(box.lo[3]) | std::uint32_t(box.hi[3]) << 16; }
+};
+
+// Centroid of a prim's box (halves first, so no overflow near FLT_MAX).
+inline F4 centroidOf(const Prim& p) { return splat(0.5f) * p.box.lo + splat(0.5f) * p.box.hi; }
+
+// Bins of a centroid on all axes: floor((c - cmin) * scale) clamped to [0, bins - 1]. A NaN from a
+// flat or overflowing axis (scale 0) becomes bin 0, and so does the 4th lane (scale 0 there too).
+// Binning and partitioning both use this function.
+inline I4 binsOf(F4 c, F4 cmin, F4 scale, F4 lastBin) {
+  return __builtin_convertvector(vmin(vmax((c - cmin) * scale, splat(0.0f)), lastBin), I4);
+}
+
+struct Bin {
+  Box box;
+  int count = 0;
+};
+
+// Best split found so far: axis, position (first bin of the right child), cost
+// (area * count summed over both children) and |left - right| counts for breaking ties.
+struct Split {
+  int axis = -1;
+  int pos = 0;
+  double cost = std::numeric_limits<double>::infinity();
+  std::uint32_t imbalance = ~0u;
+  void consider(int a, int p, double c, int countLeft, int countRight) {
+    const std::uint32_t imb = std::uint32_t(std::abs(countLeft - countRight));
+    if (c < cost || (c == cost && imb < imbalance)) {  // ties (e.g. zero areas) go to the balanced split
+      axis = a;
+      pos = p;
+      cost = c;
+      imbalance = imb;
+    }
+  }
+  bool found() const { return axis >= 0 && std::isfinite(cost); }
+};
+
+// A node still to be built: its slot in the node array, its range of prims, its level, the bounds
+// of its prims and the bounds of their centroids.
+struct WorkItem {
+  std::uint32_t node;
+  std::uint32_t first;
+  std::uint32_t count;
+  int depth;
+  Box box;
+  Box cbox;
+};
+
+// Levels that a median-split subtree over n prims needs below its root: ceil(log2(ceil(n / leaf))).
+int medianLevels(std::uint64_t n, std::uint64_t leaf) {
+  const std::uint64_t leaves = (n + leaf - 1) / leaf;
+  int levels = 0;
+  while ((std::uint64_t(1) << levels) < leaves) ++levels;
+  return levels;
+}
+
+// Bounds and centroid bounds of prims [first, first + count).
+void boundsOfRange(const std::vector<Prim>& prims, std::uint32_t first, std::uint32_t count, Box& box, Box& cbox) {
+  box = Box{};
+  cbox = Box{};
+  for (std::uint32_t i = first; i < first + count; ++i) {
+    box.grow(prims[i].box);
+    cbox.grow(centroidOf(prims[i]));
+  }
+}
+
+// Finite box of one triangle. A triangle with a NaN or infinite coordinate never hits, so it is
+// binned as a point at the origin; this keeps every bound and centroid finite.
+Box triangleBox(const Triangle& tri) {
+  Box b;
+  for (const glm::vec3& p : tri.p) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      b.lo = b.hi = splat(0.0f);
+      return b;
+    }
+    b.grow(F4{p.x, p.y, p.z, 0.0f});
+  }
+  return b;
+}
+
+}  // namespace
+
+Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
+  if (options.bins < 2 || options.bins > kMaxBins)
+    throw Error("bvh.cpp: BvhBuildOptions::bins must be in [2, " + std::to_string(kMaxBins) + "]");
+  if (options.maxLeafSize < 1) throw Error("bvh.cpp: BvhBuildOptions::maxLeafSize must be >= 1");
+  if (triangles.size() >= std::size_t(0x7fffffff))
+    throw Error("bvh.cpp: too many triangles (" + std::to_string(triangles.size()) + ")");
+
+  Bvh bvh;
+  const std::uint32_t n = std::uint32_t(triangles.size());
+  const int bins = options.bins;
+  const std::uint32_t maxLeaf = std::uint32_t(options.maxLeafSize);
+  const double ct = options.costTraversal, ci = options.costIntersect;
+
+  if (n == 0) {  // one empty node with an inverted box: traversal rejects it before reading children
+    gpu::BvhNode empty{};
+    empty.bmin = glm::vec3(kInf);
+    empty.bmax = glm::vec3(-kInf);
+    bvh.nodes.push_back(empty);
+    bvh.depth = 1;
+    bvh.leafCount = 1;
+    return bvh;
+  }
+
+  std::vector<Prim> prims;
+  prims.reserve(n);
+  for (std::uint32_t i = 0; i < n; ++i) prims.emplace_back(triangleBox(triangles[i]), i);
+
+  bvh.nodes.reserve(2 * std::size_t(n));
+  bvh.nodes.emplace_back();
+  std::vector<WorkItem> work;
+  work.push_back({0, 0, n, 1, Box{}, Box{}});
+  boundsOfRange(prims, 0, n, work.back().box, work.back().cbox);
+  const double rootArea = work.back().box.halfArea();
+  const bool rootAreaOk = rootArea > 0.0 && std::isfinite(rootArea);
+  double sah = 0.0;  // SAH cost relative to the root's area
+
+  Bin binsPerAxis[3][kMaxBins];  // kept empty between nodes
+  const F4 lastBin = splat(float(bins - 1));
+  while (!work.empty()) {
+    const WorkItem item = work.back();
+    work.pop_back();
+    const double nodeArea = item.box.halfArea();
+    const double relArea = rootAreaOk ? nodeArea / rootArea : 1.0;
+    gpu::BvhNode& out = bvh.nodes[item.node];
+    out.bmin = glm::vec3(item.box.lo[0], item.box.lo[1], item.box.lo[2]);
+    out.bmax = glm::vec3(item.box.hi[0], item.box.hi[1], item.box.hi[2]);
+
+    auto makeLeaf = [&]() {
+      if (item.count > maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
+      gpu::BvhNode& leaf = bvh.nodes[item.node];
+      leaf.leftFirst = item.first;
+      leaf.triCount = item.count;
+      bvh.leafCount++;
+      bvh.depth = std::max(bvh.depth, item.depth);
+      sah += ci * double(item.count) * relArea;
+    };
+    if (item.count == 1 || item.depth >= kMaxLeafDepth) {
+      makeLeaf();
+      continue;
+    }
+
+    // Axes with a usable centroid extent get binned; flat (or overflowing) axes get scale 0.
+    F4 scale = splat(0.0f);
+    bool anyAxis = false;
+    for (int a = 0; a < 3; ++a) {
+      const float s = float(bins) / (item.cbox.hi[a] - item.cbox.lo[a]);
+      scale[a] = (s > 0.0f && std::isfinite(s)) ? s : 0.0f;
+      anyAxis |= scale[a] > 0.0f;
+    }
+
+    // Binned SAH over the axes with a centroid extent; pos = first bin of the right child. Costs are
+    // in units of area * count (the node's own terms are constant).
+    Split best;
+    if (anyAxis) {
+      for (std::uint32_t i = item.first; i < item.first + item.count; ++i) {
+        const Prim& p = prims[i];
+        const I4 b = binsOf(centroidOf(p), item.cbox.lo, scale, lastBin);
+        for (int a = 0; a < 3; ++a) {  // flat axes all land in bin 0 and are ignored below
+          Bin& bin = binsPerAxis[a][b[a]];
+          bin.box.grow(p.box);
+          bin.count++;
+        }
+      }
+      for (int a = 0; a < 3; ++a) {
+        if (scale[a] <= 0.0f) {
+          binsPerAxis[a][0] = Bin{};
+          continue;
+        }
+        // Sweep over the non-empty bins only (planes between empty bins give the same partitions).
+        int used[kMaxBins], m = 0;
+        for (int i = 0; i < bins; ++i)
+          if (binsPerAxis[a][i].count > 0) used[m++] = i;
+        double rightCost[kMaxBins];  // area * count of used bins [k, m)
+        int rightCount[kMaxBins];
+        Box acc;
+        int cnt = 0;
+        for (int k = m - 1; k > 0; --k) {
+          const Bin& bin = binsPerAxis[a][used[k]];
+          acc.grow(bin.box);
+          cnt += bin.count;
+          rightCost[k] = acc.halfArea() * cnt;
+          rightCount[k] = cnt;
+        }
+        acc = Box{};
+        cnt = 0;
+        for (int k = 1; k < m; ++k) {
+          const Bin& bin = binsPerAxis[a][used[k - 1]];
+          acc.grow(bin.box);
+          cnt += bin.count;
+          best.consider(a, used[k], acc.halfArea() * cnt + rightCost[k], cnt, rightCount[k]);
+        }
+        for (int k = 0; k < m; ++k) binsPerAxis[a][used[k]] = Bin{};  // all bins empty again
+      }
+    }
+
+    if (item.count <= maxLeaf) {
+      // Small enough for a leaf: split only if SAH says it pays.
+      const bool split = best.found() && ct * nodeArea + ci * best.cost < ci * double(item.count) * nodeArea;
+      if (!split) {
+        makeLeaf();
+        continue;
+      }
+    }
+
+    // Split at the SAH plane unless the depth budget requires a median split (which keeps
+    // depth + medianLevels(count) constant, so leaves never pass kMaxLeafDepth).
+    const bool forceMedian = item.depth + medianLevels(item.count, maxLeaf) >= kMaxLeafDepth;
+    WorkItem left{0, item.first, 0, item.depth + 1, Box{}, Box{}};
+    WorkItem right{0, 0, 0, item.depth + 1, Box{}, Box{}};
+    if (best.found() && !forceMedian) {
+      // In-place partition; child bounds come from the prims themselves, so they are exact.
+      std::uint32_t i = item.first, j = item.first + item.count;
+      while (i < j) {
+        const F4 c = centroidOf(prims[i]);
+        if (binsOf(c, item.cbox.lo, scale, lastBin)[best.axis] < best.pos) {
+          left.box.grow(prims[i].box);
+          left.cbox.grow(c);
+          ++i;
+        } else {
+          --j;
+          std::swap(prims[i], prims[j]);
+          right.box.grow(prims[j].box);
+          right.cbox.grow(c);
+        }
+      }
+      left.count = i - item.first;
+    }
+    if (left.count == 0 || left.count == item.count) {
+      // Median split along the widest centroid axis (any order when all centroids coincide).
+      int a = 0;
+      for (int k = 1; k < 3; ++k)
+        if (item.cbox.hi[k] - item.cbox.lo[k] > item.cbox.hi[a] - item.cbox.lo[a]) a = k;
+      left.count = item.count / 2;
+      Prim* begin = prims.data() + item.first;
+      std::nth_element(begin, begin + left.count, begin + item.count,
+                       [a](const Prim& p, const Prim& q) { return centroidOf(p)[a] < centroidOf(q)[a]; });
+      boundsOfRange(prims, item.first, left.count, left.box, left.cbox);
+      boundsOfRange(prims, item.first + left.count, item.count - left.count, right.box, right.cbox);
+    }
+    right.first = item.first + left.count;
+    right.count = item.count - left.count;
+
+    left.node = std::uint32_t(bvh.nodes.size());
+    right.node = left.node + 1;
+    bvh.nodes[item.node].leftFirst = left.node;
+    bvh.nodes[item.node].triCount = 0;
+    bvh.nodes.emplace_back();
+    bvh.nodes.emplace_back();
+    sah += ct * relArea;
+    work.push_back(right);
+    work.push_back(left);
+  }
+
+  if (bvh.depth >= CAUSTICA_BVH_STACK)
+    throw Error("bvh.cpp: BVH depth " + std::to_string(bvh.depth) + " exceeds the traversal stack");
+  bvh.sahCost = float(sah);
+  bvh.order.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
+  return bvh;
+}
+
+std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh) {
+  if (bvh.order.size() != triangles.size())
+    throw Error("bvh.cpp: BVH was built for " + std::to_string(bvh.order.size()) + " triangles, got " +
+                std::to_string(triangles.size()));
+  std::vector<gpu::TriGeom> out(triangles.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const Triangle& t = triangles[bvh.order[i]];
+    out[i].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
+    out[i].v1 = glm::vec4(t.p[1], 0.0f);
+    out[i].v2 = glm::vec4(t.p[2], 0.0f);
+  }
+  return out;
+}
+
+namespace {
+
+// Cyclic permutation that moves axis kz to z (keeps handedness; both faces are accepted anyway).
+inline glm::vec3 permuteToKz(const glm::vec3& a, int kz) {
+  return kz == 0 ? glm::vec3(a.y, a.z, a.x) : (kz == 1 ? glm::vec3(a.z, a.x, a.y) : a);
+}
+
+}  // namespace
+
+// Woop, Benthin, Wald 2013 ("Watertight ray/triangle intersection"), in the form of pbrt-v4's
+// IntersectTriangle: translate to the ray origin, permute so the largest direction component is z,
+// shear so the ray is +z, then 2D edge functions. Shared edges give exactly negated edge functions,
+// so no ray passes between two triangles. Exactly zero edge functions are recomputed in double.
+bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
+                       float tmax, float& t, float& u, float& v) {
+  const glm::vec3 ad = glm::abs(ray.dir);
+  const int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+  const glm::vec3 d = permuteToKz(ray.dir, kz);
+  if (d.z == 0.0f) return false;  // zero direction
+  const float sz = 1.0f / d.z;
+  const float sx = -d.x * sz, sy = -d.y * sz;
+
+  const glm::vec3 a = permuteToKz(p0 - ray.origin, kz);
+  const glm::vec3 b = permuteToKz(p1 - ray.origin, kz);
+  const glm::vec3 c = permuteToKz(p2 - ray.origin, kz);
+  const float ax = a.x + sx * a.z, ay = a.y + sy * a.z;
+  const float bx = b.x + sx * b.z, by = b.y + sy * b.z;
+  const float cx = c.x + sx * c.z, cy = c.y + sy * c.z;
+
+  float e0 = bx * cy - by * cx;  // edge function opposite p0 (weight of p0)
+  float e1 = cx * ay - cy * ax;  // opposite p1
+  float e2 = ax * by - ay * bx;  // opposite p2
+  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) {  // products of floats are exact in double
+    e0 = float(double(bx) * double(cy) - double(by) * double(cx));
+    e1 = float(double(cx) * double(ay) - double(cy) * double(ax));
+    e2 = float(double(ax) * double(by) - double(ay) * double(bx));
+  }
+  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+  const float det = e0 + e1 + e2;
+  if (det == 0.0f) return false;  // ray in the triangle's plane
+  // Zero-area triangles can pass the test above once their vertices are rounded in ray space.
+  const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
+  if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return false;
+
+  const float tScaled = e0 * (sz * a.z) + e1 * (sz * b.z) + e2 * (sz * c.z);
+  const float invDet = 1.0f / det;
+  const float tt = tScaled * invDet;
+  if (!(tt > 0.0f && tt < tmax)) return false;  // also rejects NaN
+  t = tt;
+  u = e1 * invDet;
+  v = e2 * invDet;
+  return true;
+}
+
+namespace {
+
+constexpr float kDirTiny = 1e-20f;
+// Relative widening of a box's exit distance: covers the rounding of the slab distances and of t.
+constexpr float kBoxPad = 1.0f + 1.0f / (1 << 20);
+constexpr float kBig = 3.0e38f;
+
+// Guarded reciprocal: |d| < 1e-20 becomes +-1e-20 (sign by d >= 0, as in GLSL), so never inf or NaN.
+inline glm::vec3 safeInverse(const glm::vec3& d) {
+  glm::vec3 r;
+  for (int a = 0; a < 3; ++a) {
+    const float g = std::fabs(d[a]) < kDirTiny ? (d[a] >= 0.0f ? kDirTiny : -kDirTiny) : d[a];
+    r[a] = 1.0f / g;
+  }
+  return r;
+}
+
+// Slab test; twin of intersectAabb() in intersect.glsl. tnear: entry distance clamped to >= 0.
+// An exit distance of exactly 0 (origin on a slab plane with a guarded ~0 direction component)
+// is treated as "inside" so that rays lying on a box face still visit it; this is conservative.
+inline bool intersectAabb(const glm::vec3& org, const glm::vec3& invDir, const glm::vec3& bmin,
+                          const glm::vec3& bmax, float tmax, float& tnear) {
+  const glm::vec3 t0 = (bmin - org) * invDir;
+  const glm::vec3 t1 = (bmax - org) * invDir;
+  const glm::vec3 lo = glm::min(t0, t1);
+  glm::vec3 hi = glm::max(t0, t1);
+  for (int a = 0; a < 3; ++a) hi[a] = hi[a] == 0.0f ? kBig : hi[a];
+  tnear = std::max(std::max(lo.x, lo.y), std::max(lo.z, 0.0f));
+  const float tfar = std::min(std::min(hi.x, hi.y), std::min(hi.z, tmax)) * kBoxPad;
+  return tnear <= tfar;
+}
+
+// Traversal shared by closest and any hit: near child first, far child on a fixed-size stack.
+template <bool kAnyHit>
+Hit traverse(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriGeom>& tris,
+             const Ray& ray, float tmax) {
+  Hit hit;
+  if (nodes.empty()) return hit;
+  const gpu::BvhNode& root = nodes[0];
+  if (!(root.bmin.x <= root.bmax.x)) return hit;  // empty scene (inverted root box)
+  const glm::vec3 invDir = safeInverse(ray.dir);
+  float tnear;
+  if (!intersectAabb(ray.origin, invDir, root.bmin, root.bmax, tmax, tnear)) return hit;
+
+  float closest = tmax;
+  std::uint32_t stack[CAUSTICA_BVH_STACK];
+  std::uint32_t sp = 0;
+  std::uint32_t index = 0;
+  for (;;) {
+    const gpu::BvhNode& node = nodes[index];
+    if (node.triCount > 0) {
+      for (std::uint32_t i = node.leftFirst; i < node.leftFirst + node.triCount; ++i) {
+        const gpu::TriGeom& g = tris[i];
+        float t, u, v;
+        if (intersectTriangle(ray, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u, v)) {
+          closest = t;
+          hit.t = t;
+          hit.u = u;
+          hit.v = v;
+          hit.tri = i;
+          if (kAnyHit) return hit;
+        }
+      }
+    } else {
+      const std::uint32_t left = node.leftFirst;
+      float tl, tr;
+      const bool hl = intersectAabb(ray.origin, invDir, nodes[left].bmin, nodes[left].bmax, closest, tl);
+      const bool hr = intersectAabb(ray.origin, invDir, nodes[left + 1].bmin, nodes[left + 1].bmax, closest, tr);
+      if (hl && hr) {
+        const std::uint32_t first = tl <= tr ? left : left + 1;
+        // The builder bounds the depth, so this never overflows; the guard only protects memory.
+        if (sp < CAUSTICA_BVH_STACK) stack[sp++] = first == left ? left + 1 : left;
+        index = first;
+        continue;
+      }
+      if (hl || hr) {
+        index = hl ? left : left + 1;
+        continue;
+      }
+    }
+    if (sp == 0) break;
+    index = stack[--sp];
+  }
+  return hit;
+}
+
+}  // namespace
+
+Hit traceClosest(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriGeom>& tris,
+                 const Ray& ray, float tmax) {
+  return traverse<false>(nodes, tris, ray, tmax);
+}
+
+bool traceOccluded(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriGeom>& tris,
+                   const Ray& ray, float tmax) {
+  return traverse<true>(nodes, tris, ray, tmax).found();
+}
+
+}  // namespace caustica

@@ -1,0 +1,161 @@
+// gpu_scene.cpp — Scene + BVH to shader storage arrays; emitter alias table; feature detection.
+#include "accel/gpu_scene.h"
+
+#include <cmath>
+
+#include "scene/caustic_casters.h"
+#include "util/error.h"
+#include "shading/sampling.h"
+
+namespace caustica {
+
+std::vector<std::string> SceneFeatures::defines() const {
+  std::vector<std::string> d;
+  if (mirror) d.push_back("CAUSTICA_MIRROR");
+  if (glass) d.push_back("CAUSTICA_GLASS");
+  if (volume) d.push_back("CAUSTICA_VOLUME");
+  if (dispersion) d.push_back("CAUSTICA_DISPERSION");
+  if (textures) d.push_back("CAUSTICA_TEXTURES");
+  if (opacity) d.push_back("CAUSTICA_OPACITY");
+  return d;
+}
+
+std::string SceneFeatures::describe() const {
+  std::string s;
+  auto add = [&](bool on, const char* name) {
+    if (on) s += (s.empty() ? "" : " ") + std::string(name);
+  };
+  add(mirror, "mirror");
+  add(glass, "glass");
+  add(volume, "volume");
+  add(dispersion, "dispersion");
+  add(textures, "textures");
+  add(opacity, "opacity");
+  return s.empty() ? "diffuse only" : s;
+}
+
+SceneFeatures sceneFeatures(const Scene& scene) {
+  std::vector<bool> used(scene.materials.size(), false);
+  for (const auto& t : scene.triangles)
+    if (t.material < used.size()) used[t.material] = true;
+  SceneFeatures f;
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    if (!used[i]) continue;
+    const Material& m = scene.materials[i];
+    f.mirror |= m.metallic > 0.0f;
+    bool glass = m.transmission > 0.0f && m.metallic < 1.0f;
+    f.glass |= glass;
+    f.volume |= glass && std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f &&
+                glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
+    f.dispersion |= glass && m.dispersion > 0.0f;
+    f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
+    f.opacity |= m.baseColor.a < 1.0f;
+  }
+  return f;
+}
+
+std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items) {
+  size_t n = weights.size();
+  std::vector<gpu::Emitter> table(n);
+  double total = 0.0;
+  for (double w : weights) total += w;
+  if (n == 0 || !(total > 0.0)) return {};
+  std::vector<double> scaled(n);
+  std::vector<size_t> small, large;
+  for (size_t i = 0; i < n; ++i) {
+    scaled[i] = weights[i] * static_cast<double>(n) / total;
+    (scaled[i] < 1.0 ? small : large).push_back(i);
+    table[i].tri = items[i];
+    table[i].pdfSelect = static_cast<float>(weights[i] / total);
+    table[i].alias = static_cast<std::uint32_t>(i);
+    table[i].prob = 1.0f;
+  }
+  while (!small.empty() && !large.empty()) {
+    size_t s = small.back(), l = large.back();
+    small.pop_back();
+    table[s].prob = static_cast<float>(scaled[s]);
+    table[s].alias = static_cast<std::uint32_t>(l);
+    scaled[l] -= 1.0 - scaled[s];
+    if (scaled[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  // Leftovers are 1 up to rounding.
+  for (size_t i : small) table[i].prob = 1.0f;
+  for (size_t i : large) table[i].prob = 1.0f;
+  return table;
+}
+
+GpuScene packScene(const Scene& scene, const Bvh& bvh) {
+  GpuScene g;
+  g.features = sceneFeatures(scene);
+  g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
+  g.emitterSphere = emitterBoundingSphere(scene);
+  g.nodes = bvh.nodes;
+  g.triGeom = packTriGeom(scene.triangles, bvh);
+  g.triShade.resize(bvh.order.size());
+  for (size_t i = 0; i < bvh.order.size(); ++i) {
+    const Triangle& t = scene.triangles[bvh.order[i]];
+    gpu::TriShade& s = g.triShade[i];
+    s.n0 = glm::vec4(t.n[0], t.uv[0].x);
+    s.n1 = glm::vec4(t.n[1], t.uv[1].x);
+    s.n2 = glm::vec4(t.n[2], t.uv[2].x);
+    s.vt = glm::vec4(t.uv[0].y, t.uv[1].y, t.uv[2].y, 0.0f);
+  }
+
+  for (const Material& m : scene.materials) {
+    gpu::Material gm{};
+    gm.baseColor = m.baseColor;
+    gm.emission = glm::vec4(glm::max(m.emission, glm::vec3(0.0f)), 0.0f);
+    gm.params = glm::vec4(m.metallic, m.roughness, m.transmission, m.ior);
+    glm::vec3 absorption(0.0f);
+    std::uint32_t flags = m.doubleSided ? gpu::kMatDoubleSided : 0u;
+    if (std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f) {
+      absorption = -glm::log(glm::clamp(m.attenuationColor, glm::vec3(1e-6f), glm::vec3(1.0f))) / m.attenuationDistance;
+      if (glm::any(glm::greaterThan(absorption, glm::vec3(0.0f)))) flags |= gpu::kMatHasVolume;
+    }
+    float abbe = m.dispersion > 0.0f ? 20.0f / m.dispersion : 0.0f;
+    if (abbe > 0.0f) flags |= gpu::kMatDispersive;
+    gm.absorption = glm::vec4(absorption, abbe);
+    gm.tex = glm::uvec4(m.baseColorTexture >= 0 ? static_cast<std::uint32_t>(m.baseColorTexture) : gpu::kInvalidIndex,
+                        m.emissiveTexture >= 0 ? static_cast<std::uint32_t>(m.emissiveTexture) : gpu::kInvalidIndex,
+                        flags, 0u);
+    g.materials.push_back(gm);
+  }
+
+  for (const Texture& t : scene.textures) {
+    gpu::TexInfo info{};
+    info.offset = static_cast<std::uint32_t>(g.texels.size());
+    info.width = static_cast<std::uint32_t>(t.width);
+    info.height = static_cast<std::uint32_t>(t.height);
+    info.flags = (t.repeatS ? 1u : 0u) | (t.repeatT ? 2u : 0u) | (t.mirrorS ? 4u : 0u) | (t.mirrorT ? 8u : 0u) |
+                 (t.nearest ? 16u : 0u);
+    for (size_t i = 0; i + 3 < t.rgba.size(); i += 4)
+      g.texels.push_back(std::uint32_t(t.rgba[i]) | std::uint32_t(t.rgba[i + 1]) << 8 |
+                         std::uint32_t(t.rgba[i + 2]) << 16 | std::uint32_t(t.rgba[i + 3]) << 24);
+    g.texInfo.push_back(info);
+  }
+
+  // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
+  std::vector<double> weights;
+  std::vector<std::uint32_t> tris;
+  double totalWeight = 0.0;
+  for (size_t i = 0; i < g.triGeom.size(); ++i) {
+    const Material& m = scene.materials[scene.triangles[bvh.order[i]].material];
+    if (!m.isEmissive()) continue;
+    const gpu::TriGeom& t = g.triGeom[i];
+    double area = 0.5 * glm::length(glm::cross(glm::vec3(t.v1) - glm::vec3(t.v0), glm::vec3(t.v2) - glm::vec3(t.v0)));
+    double w = static_cast<double>(luminance(glm::max(m.emission, glm::vec3(0.0f)))) * area * (m.doubleSided ? 2.0 : 1.0);
+    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    weights.push_back(w);
+    tris.push_back(static_cast<std::uint32_t>(i));
+    totalWeight += w;
+  }
+  g.totalEmitterWeight = static_cast<float>(totalWeight);
+  g.totalPower = kPi * totalWeight;
+  g.emitters = buildAliasTable(weights, tris);
+  return g;
+}
+
+}  // namespace caustica

@@ -1,0 +1,173 @@
+// gl_objects.cpp — the one place where OpenGL objects are created and deleted.
+#include "gpu/gl_objects.h"
+
+#include <algorithm>
+
+#include "util/error.h"
+
+namespace caustica {
+
+namespace {
+void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
+void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
+void deleteProgram(GLuint id) { glDeleteProgram(id); }
+void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
+
+std::string errorName(GLenum e) {
+  switch (e) {
+    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    default: return "GL error " + std::to_string(e);
+  }
+}
+}  // namespace
+
+void checkGlError(const char* what) {
+  GLenum e = glGetError();
+  if (e != GL_NO_ERROR) throw Error(std::string("OpenGL error during ") + what + ": " + errorName(e));
+}
+
+GlBuffer GlBuffer::create(std::size_t bytes, const void* data, GLenum usage) {
+  GlBuffer b;
+  GLuint id = 0;
+  glGenBuffers(1, &id);
+  b.handle_ = GlHandle(id, deleteBuffer);
+  b.size_ = std::max<std::size_t>(bytes, 16);
+  glBindBuffer(GL_COPY_WRITE_BUFFER, id);
+  if (bytes >= 16 || !data) {
+    glBufferData(GL_COPY_WRITE_BUFFER, static_cast<GLsizeiptr>(b.size_), data, usage);
+  } else {  // pad tiny arrays to 16 bytes
+    std::vector<unsigned char> padded(16, 0);
+    std::copy_n(static_cast<const unsigned char*>(data), bytes, padded.begin());
+    glBufferData(GL_COPY_WRITE_BUFFER, 16, padded.data(), usage);
+  }
+  if (!data) {
+    std::vector<unsigned char> zeros(b.size_, 0);
+    glBufferSubData(GL_COPY_WRITE_BUFFER, 0, static_cast<GLsizeiptr>(b.size_), zeros.data());
+  }
+  glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+  checkGlError("buffer creation");
+  return b;
+}
+
+void GlBuffer::update(std::size_t offset, std::size_t bytes, const void* data) {
+  glBindBuffer(GL_COPY_WRITE_BUFFER, id());
+  glBufferSubData(GL_COPY_WRITE_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+  glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+}
+
+void GlBuffer::read(std::size_t offset, std::size_t bytes, void* out) const {
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBuffer(GL_COPY_READ_BUFFER, id());
+  glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), out);
+  glBindBuffer(GL_COPY_READ_BUFFER, 0);
+}
+
+void GlBuffer::bindBase(GLenum target, GLuint index) const { glBindBufferBase(target, index, id()); }
+
+GlTexture GlTexture::create2D(int width, int height, GLenum internalFormat) {
+  GlTexture t;
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  t.handle_ = GlHandle(id, deleteTexture);
+  t.width_ = width;
+  t.height_ = height;
+  t.format_ = internalFormat;
+  glBindTexture(GL_TEXTURE_2D, id);
+  glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, width, height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("texture creation");
+  t.clear();
+  return t;
+}
+
+void GlTexture::clear() {
+  // glClearTexImage is GL 4.4: upload zeros instead.
+  glBindTexture(GL_TEXTURE_2D, id());
+  if (format_ == GL_RGBA32F) {
+    std::vector<float> zeros(static_cast<std::size_t>(width_) * height_ * 4, 0.0f);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, zeros.data());
+  } else {
+    std::vector<unsigned char> zeros(static_cast<std::size_t>(width_) * height_ * 4, 0);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, zeros.data());
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+void GlTexture::bindImage(GLuint unit, GLenum access) const {
+  glBindImageTexture(unit, id(), 0, GL_FALSE, 0, access, format_);
+}
+
+std::vector<float> GlTexture::readRgba32f() const {
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  std::vector<float> out(static_cast<std::size_t>(width_) * height_ * 4);
+  glBindTexture(GL_TEXTURE_2D, id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, out.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("image readback");
+  return out;
+}
+
+GlProgram GlProgram::compileCompute(const std::string& source,
+                                    const std::function<std::string(const std::string&)>& mapLog,
+                                    const std::string& name) {
+  GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+  const char* src = source.c_str();
+  glShaderSource(shader, 1, &src, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  auto infoLog = [](GLuint obj, bool isShader) {
+    GLint len = 0;
+    isShader ? glGetShaderiv(obj, GL_INFO_LOG_LENGTH, &len) : glGetProgramiv(obj, GL_INFO_LOG_LENGTH, &len);
+    std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
+    isShader ? glGetShaderInfoLog(obj, len, nullptr, log.data()) : glGetProgramInfoLog(obj, len, nullptr, log.data());
+    log.resize(std::min(log.size(), log.find('\0')));
+    return log;
+  };
+  if (!ok) {
+    std::string log = infoLog(shader, true);
+    glDeleteShader(shader);
+    throw Error("shader " + name + " failed to compile:\n" + mapLog(log));
+  }
+  GlProgram p;
+  GLuint prog = glCreateProgram();
+  p.handle_ = GlHandle(prog, deleteProgram);
+  glAttachShader(prog, shader);
+  glLinkProgram(prog);
+  glDeleteShader(shader);  // flagged; freed with the program
+  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+  if (!ok) throw Error("shader " + name + " failed to link:\n" + mapLog(infoLog(prog, false)));
+  return p;
+}
+
+void GlProgram::use() const { glUseProgram(id()); }
+GLint GlProgram::uniformLocation(const char* n) const { return glGetUniformLocation(id(), n); }
+
+GlFramebuffer GlFramebuffer::forTexture(const GlTexture& texture) {
+  GlFramebuffer f;
+  GLuint id = 0;
+  glGenFramebuffers(1, &id);
+  f.handle_ = GlHandle(id, deleteFramebuffer);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, id);
+  glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
+  if (glCheckFramebufferStatus(GL_READ_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) throw Error("display framebuffer incomplete");
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  return f;
+}
+
+void GlFramebuffer::blitToDefault(int srcW, int srcH, int dstW, int dstH) const {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, handle_.id());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  // Row 0 of the image is the top: flip vertically while blitting.
+  glBlitFramebuffer(0, 0, srcW, srcH, 0, dstH, dstW, 0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+}
+
+}  // namespace caustica

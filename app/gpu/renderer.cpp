@@ -1,0 +1,300 @@
+// renderer.cpp — scene upload, shader variants, dispatch and readback for the GPU path tracer.
+#include "gpu/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "util/error.h"
+
+namespace caustica {
+
+Integrator parseIntegrator(const std::string& name) {
+  if (name == "naive") return Integrator::Naive;
+  if (name == "mis") return Integrator::Mis;
+  throw Error("unknown integrator '" + name + "' (expected naive or mis)");
+}
+
+DispersionMode parseDispersionMode(const std::string& name) {
+  if (name == "rgb") return DispersionMode::Rgb;
+  if (name == "spectral") return DispersionMode::Spectral;
+  throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
+}
+
+const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
+const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
+
+GlLimits queryGlLimits() {
+  GlLimits l;
+  GLint64 block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  l.maxStorageBlockSize = block;
+  // CAUSTICA_MAX_SSBO_BYTES lowers the limit, to see how a scene fares on a GPU that offers only the
+  // 16 MiB the specification guarantees (used by the tests).
+  if (const char* env = std::getenv("CAUSTICA_MAX_SSBO_BYTES")) {
+    long long cap = std::atoll(env);
+    if (cap > 0 && cap < l.maxStorageBlockSize) l.maxStorageBlockSize = cap;
+  }
+  glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &l.maxComputeStorageBlocks);
+  glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &l.maxWorkGroupInvocations);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.maxTextureSize);
+  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &l.maxWorkGroupCount[0]);
+  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &l.maxWorkGroupCount[1]);
+  return l;
+}
+
+namespace {
+
+std::string mib(double bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
+  return buf;
+}
+
+void checkImageSize(const GlLimits& l, int w, int h) {
+  if (w < 1 || h < 1) throw Error("image size must be at least 1x1");
+  if (w > l.maxTextureSize || h > l.maxTextureSize)
+    throw Error("image size " + std::to_string(w) + "x" + std::to_string(h) + " exceeds this GPU's texture limit of " +
+                std::to_string(l.maxTextureSize));
+  int gx = (w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X, gy = (h + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y;
+  if (gx > l.maxWorkGroupCount[0] || gy > l.maxWorkGroupCount[1]) throw Error("image too large for one compute dispatch");
+}
+
+void checkCasterProbability(float p) {
+  if (!(p >= 0.0f && p <= kMaxCasterProbability)) {
+    std::ostringstream m;
+    m << "caster probability must be between 0 and " << kMaxCasterProbability;
+    throw Error(m.str());
+  }
+}
+
+}  // namespace
+
+Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
+    : library_(library), settings_(settings), camera_(camera) {
+  limits_ = queryGlLimits();
+  if (limits_.maxComputeStorageBlocks < CAUSTICA_SSBO_COUNT)
+    throw Error("this GPU allows " + std::to_string(limits_.maxComputeStorageBlocks) +
+                " storage buffers per compute shader; caustica needs " + std::to_string(CAUSTICA_SSBO_COUNT));
+  if (limits_.maxWorkGroupInvocations < CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y)
+    throw Error("this GPU's compute work groups are too small");
+  checkImageSize(limits_, settings_.width, settings_.height);
+  if (settings_.maxDepth < 1 || settings_.maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
+  checkCasterProbability(settings_.casterProbability);
+
+  auto t0 = std::chrono::steady_clock::now();
+  bvh_ = buildBvh(scene.triangles);
+  bvhSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  gpuScene_ = packScene(scene, bvh_);
+
+  auto sized = [&](const char* what, size_t bytes) {
+    if (static_cast<std::int64_t>(bytes) > limits_.maxStorageBlockSize)
+      throw Error(scene.path + ": " + what + " need " + mib(static_cast<double>(bytes)) +
+                  " but this GPU allows " + mib(static_cast<double>(limits_.maxStorageBlockSize)) +
+                  " per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE)");
+  };
+  const GpuScene& g = gpuScene_;
+  sized("BVH nodes", g.nodes.size() * sizeof(gpu::BvhNode));
+  sized("triangles", g.triShade.size() * sizeof(gpu::TriShade));
+  sized("materials", g.materials.size() * sizeof(gpu::Material));
+  sized("emitters", g.emitters.size() * sizeof(gpu::Emitter));
+  sized("textures", g.texels.size() * 4);
+
+  buffers_.resize(CAUSTICA_SSBO_COUNT);
+  buffers_[CAUSTICA_BINDING_NODES] = GlBuffer::fromVector(g.nodes);
+  buffers_[CAUSTICA_BINDING_TRIGEOM] = GlBuffer::fromVector(g.triGeom);
+  buffers_[CAUSTICA_BINDING_TRISHADE] = GlBuffer::fromVector(g.triShade);
+  buffers_[CAUSTICA_BINDING_MATERIALS] = GlBuffer::fromVector(g.materials);
+  buffers_[CAUSTICA_BINDING_EMITTERS] = GlBuffer::fromVector(g.emitters);
+  buffers_[CAUSTICA_BINDING_TEXELS] = GlBuffer::fromVector(g.texels);
+  buffers_[CAUSTICA_BINDING_TEXINFO] = GlBuffer::fromVector(g.texInfo);
+  buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
+  frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
+  casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
+  uploadCasters();
+  resize(settings_.width, settings_.height);
+  program();  // compile now, so shader errors surface before rendering starts
+}
+
+std::vector<std::string> Renderer::shaderDefines() const {
+  std::vector<std::string> d = gpuScene_.features.defines();
+  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) {
+    d.push_back("CAUSTICA_MIS");
+    if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
+  }
+  if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
+  return d;
+}
+
+const GlProgram& Renderer::program() {
+  std::vector<std::string> defines = shaderDefines();
+  std::string key;
+  for (const auto& d : defines) key += d + " ";
+  auto it = programs_.find(key);
+  if (it != programs_.end()) return it->second;
+  ExpandedShader src = library_.expand("pathtrace.comp", defines);
+  GlProgram p = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
+                                          "pathtrace.comp");
+  return programs_.emplace(key, std::move(p)).first->second;
+}
+
+void Renderer::setCamera(const Camera& camera) {
+  camera_ = camera;
+  reset();
+}
+void Renderer::setIntegrator(Integrator integrator) {
+  settings_.integrator = integrator;
+  program();
+  reset();
+}
+void Renderer::setDispersionMode(DispersionMode mode) {
+  settings_.dispersion = mode;
+  program();
+  reset();
+}
+void Renderer::setMaxDepth(int maxDepth) {
+  if (maxDepth < 1 || maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
+  settings_.maxDepth = maxDepth;
+  reset();
+}
+
+void Renderer::setCasterProbability(float p) {
+  checkCasterProbability(p);
+  settings_.casterProbability = p;
+  uploadCasters();
+  program();
+  reset();
+}
+
+void Renderer::uploadCasters() {
+  gpu::CasterParams cp{};
+  cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
+  cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, 0.0f, 0.0f);
+  cp.lights = gpuScene_.emitterSphere;
+  for (std::uint32_t i = 0; i < cp.count.x; ++i) {
+    cp.sphere[i] = gpuScene_.casters[i].sphere;
+    if (gpuScene_.casters[i].refractive) cp.count.y |= 1u << i;
+  }
+  casterUbo_.update(0, sizeof cp, &cp);
+}
+
+void Renderer::resize(int width, int height) {
+  checkImageSize(limits_, width, height);
+  settings_.width = width;
+  settings_.height = height;
+  accum_ = GlTexture::create2D(width, height, GL_RGBA32F);
+  comp_ = GlTexture::create2D(width, height, GL_RGBA32F);
+  display_ = GlTexture();
+  reset();
+}
+
+void Renderer::reset() {
+  accum_.clear();
+  comp_.clear();
+  spp_ = 0;
+  sampleBase_ = 0;
+  stats_ = RenderStats{};
+  gpu::Counters zero{};
+  buffers_[CAUSTICA_BINDING_COUNTERS].update(0, sizeof zero, &zero);
+}
+
+void Renderer::renderRows(int y0, int y1, int spp) {
+  y0 = std::max(0, y0);
+  y1 = std::min(settings_.height, y1);
+  if (y1 <= y0 || spp <= 0) return;
+  const GlProgram& prog = program();
+  const int w = settings_.width, h = settings_.height;
+  float aspect = static_cast<float>(w) / static_cast<float>(h);
+  float tanHalf = std::tan(0.5f * camera_.yfov);
+  glm::vec3 fwd = glm::normalize(camera_.forward);
+  glm::vec3 right = glm::normalize(glm::cross(fwd, camera_.up));
+  glm::vec3 up = glm::cross(right, fwd);
+  gpu::FrameParams fp{};
+  fp.camPos = glm::vec4(camera_.position, 1.0f);
+  fp.camRight = glm::vec4(right * tanHalf * aspect, 0.0f);
+  fp.camUp = glm::vec4(up * tanHalf, 0.0f);
+  fp.camForward = glm::vec4(fwd, 0.0f);
+  fp.tile = glm::uvec4(0, y0, w, y1 - y0);
+  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 1.0f, 0.0f, 0.0f);
+
+  prog.use();
+  for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
+  frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
+  casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
+  accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
+  comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
+  // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested
+  // loops together (65535 from the outermost loop's start) and silently stops beyond; a per-sample
+  // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
+  // depend on how samples are split.
+  // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
+  // (a sample traces at most 2 * maxDepth + 1 rays).
+  const std::uint64_t raysPerDispatch =
+      static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0) * (2u * settings_.maxDepth + 1u);
+  const int dispatchesPerRead = static_cast<int>(std::max<std::uint64_t>(1, (1ull << 31) / raysPerDispatch));
+  for (int s = 0; s < spp; ++s) {
+    if (s > 0 && s % dispatchesPerRead == 0) readCounters();
+    fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
+    fp.options = glm::uvec4(settings_.maxDepth, 0u, gpuScene_.emitters.size(),
+                            (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
+                                (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
+    frameUbo_.update(0, sizeof fp, &fp);
+    glDispatchCompute((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
+                      (y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+  }
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+  checkGlError("path tracing dispatch");
+  readCounters();
+}
+
+void Renderer::endPass(int spp) {
+  spp_ += spp;
+  sampleBase_ += static_cast<std::uint32_t>(spp);
+}
+
+void Renderer::readCounters() {
+  gpu::Counters c{};
+  GlBuffer& buf = buffers_[CAUSTICA_BINDING_COUNTERS];
+  buf.read(0, sizeof c, &c);
+  stats_.primaryRays += c.primaryRays;
+  stats_.secondaryRays += c.secondaryRays;
+  stats_.shadowRays += c.shadowRays;
+  stats_.nonFinite += c.nonFinite;
+  gpu::Counters zero{};
+  buf.update(0, sizeof zero, &zero);
+}
+
+Image Renderer::image() const {
+  std::vector<float> rgba = accum_.readRgba32f();
+  Image img{settings_.width, settings_.height, std::vector<float>(static_cast<size_t>(settings_.width) * settings_.height * 3)};
+  for (size_t i = 0; i < static_cast<size_t>(settings_.width) * settings_.height; ++i) {
+    float n = rgba[i * 4 + 3];
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = n > 0.0f ? rgba[i * 4 + c] / n : 0.0f;
+  }
+  return img;
+}
+
+const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {
+  if (!tonemapProgram_.id()) {
+    ExpandedShader src = library_.expand("tonemap.comp", {});
+    tonemapProgram_ = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
+                                                "tonemap.comp");
+  }
+  if (display_.width() != settings_.width || display_.height() != settings_.height)
+    display_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA8);
+  tonemapProgram_.use();
+  glUniform1f(0, std::exp2(tone.exposureStops));
+  glUniform1i(1, static_cast<int>(tone.curve));
+  accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_ONLY);
+  display_.bindImage(CAUSTICA_IMAGE_DISPLAY, GL_WRITE_ONLY);
+  glDispatchCompute((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
+                    (settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
+  glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+  checkGlError("tone mapping");
+  return display_;
+}
+
+}  // namespace caustica

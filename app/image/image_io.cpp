@@ -1,0 +1,112 @@
+// image_io.cpp — PNG through stb_image_write, EXR through tinyexr, PFM by hand.
+#include "image/image_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <stb_image_write.h>
+#include <tinyexr.h>
+
+#include "util/error.h"
+
+namespace caustica {
+
+std::string fileExtension(const std::string& path) {
+  size_t dot = path.rfind('.');
+  size_t slash = path.rfind('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+void checkImageExtension(const std::string& path) {
+  std::string ext = fileExtension(path);
+  if (ext != ".png" && ext != ".exr" && ext != ".pfm")
+    throw Error(path + ": unsupported image type '" + ext + "' (use .png, .exr or .pfm)");
+}
+
+void writePng(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
+  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3))
+    throw Error(path + ": cannot write PNG");
+}
+
+namespace {
+
+void writeExr(const std::string& path, const Image& img) {
+  // tinyexr's SaveEXR takes interleaved RGB(A) floats and writes them as 32-bit float channels.
+  const char* err = nullptr;
+  int rc = SaveEXR(img.rgb.data(), img.width, img.height, 3, 0 /* float, not half */, path.c_str(), &err);
+  if (rc != TINYEXR_SUCCESS) {
+    std::string msg = err ? err : "error " + std::to_string(rc);
+    if (err) FreeEXRErrorMessage(err);
+    throw Error(path + ": cannot write EXR (" + msg + ")");
+  }
+}
+
+void writePfm(const std::string& path, const Image& img) {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw Error(path + ": cannot open for writing");
+  f << "PF\n" << img.width << " " << img.height << "\n-1.0\n";  // negative scale: little endian
+  for (int y = img.height - 1; y >= 0; --y)  // PFM rows run bottom to top
+    f.write(reinterpret_cast<const char*>(&img.rgb[static_cast<size_t>(y) * img.width * 3]),
+            static_cast<std::streamsize>(img.width) * 3 * sizeof(float));
+  if (!f) throw Error(path + ": write failed");
+}
+
+Image readExr(const std::string& path) {
+  float* rgba = nullptr;
+  int w = 0, h = 0;
+  const char* err = nullptr;
+  if (LoadEXR(&rgba, &w, &h, path.c_str(), &err) != TINYEXR_SUCCESS) {
+    std::string msg = err ? err : "unreadable";
+    if (err) FreeEXRErrorMessage(err);
+    throw Error(path + ": cannot read EXR (" + msg + ")");
+  }
+  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
+  for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = rgba[i * 4 + c];
+  std::free(rgba);
+  return img;
+}
+
+Image readPfm(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error(path + ": cannot open");
+  std::string magic;
+  int w = 0, h = 0;
+  double scale = 0;
+  f >> magic >> w >> h >> scale;
+  f.get();
+  if (!f || magic != "PF" || w <= 0 || h <= 0 || w > 65536 || h > 65536 || scale == 0.0)
+    throw Error(path + ": not a colour PFM file");
+  if (scale > 0) throw Error(path + ": big-endian PFM is not supported");
+  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
+  for (int y = h - 1; y >= 0; --y)
+    f.read(reinterpret_cast<char*>(&img.rgb[static_cast<size_t>(y) * w * 3]), static_cast<std::streamsize>(w) * 3 * 4);
+  if (!f) throw Error(path + ": truncated PFM file");
+  return img;
+}
+
+}  // namespace
+
+void writeImage(const std::string& path, const Image& image, const ToneMapSettings& tone) {
+  checkImageExtension(path);
+  std::string ext = fileExtension(path);
+  if (ext == ".png") writePng(path, image.width, image.height, tonemapImage(image.rgb, tone));
+  else if (ext == ".exr") writeExr(path, image);
+  else writePfm(path, image);
+}
+
+Image readImage(const std::string& path) {
+  std::string ext = fileExtension(path);
+  if (ext == ".exr") return readExr(path);
+  if (ext == ".pfm") return readPfm(path);
+  throw Error(path + ": cannot read '" + ext + "' images (use .exr or .pfm)");
+}
+
+}  // namespace caustica

@@ -1,0 +1,94 @@
+// scene.h — the renderer's in-memory scene: world-space triangles, materials after the glTF
+// material contract (docs/materials.md), textures and cameras. Loaded from glTF 2.0 by scene_gltf.cpp.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace caustica {
+
+// A base-colour or emissive texture, decoded to 8-bit RGBA (values as stored: sRGB-encoded colour).
+struct Texture {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;  // width * height * 4 bytes, row 0 = first row of the image (glTF uv v=0)
+  bool repeatS = true, repeatT = true;      // glTF wrap: REPEAT (or MIRRORED_REPEAT with mirror*) else CLAMP
+  bool mirrorS = false, mirrorT = false;    // MIRRORED_REPEAT
+  bool nearest = false;                     // magFilter NEAREST
+};
+
+// Material after the contract in docs/materials.md. All colours linear.
+struct Material {
+  std::string name;
+  glm::vec4 baseColor{1.0f};          // rgb: baseColorFactor, a: opacity (alpha; 1 for OPAQUE)
+  int baseColorTexture = -1;          // index into Scene::textures, -1 = none
+  float metallic = 0.0f;              // mirror weight in [0,1]
+  float roughness = 1.0f;             // kept for information; mirrors and glass are treated as smooth
+  float transmission = 0.0f;          // KHR_materials_transmission: dielectric weight in [0,1]
+  float ior = 1.5f;                   // KHR_materials_ior, at 587.6 nm
+  float dispersion = 0.0f;            // KHR_materials_dispersion (20 / Abbe number), 0 = none
+  glm::vec3 attenuationColor{1.0f};   // KHR_materials_volume
+  float attenuationDistance = std::numeric_limits<float>::infinity();  // scene units; inf = no absorption
+  glm::vec3 emission{0.0f};           // emissiveFactor * emissive_strength: emitted radiance (linear)
+  int emissiveTexture = -1;           // index into Scene::textures, -1 = none
+  bool doubleSided = false;
+
+  bool isEmissive() const { return emission.r > 0.0f || emission.g > 0.0f || emission.b > 0.0f; }
+};
+
+// One world-space triangle. Winding counter-clockwise seen from the front (glTF convention);
+// the geometric normal is normalize(cross(p1 - p0, p2 - p0)).
+struct Triangle {
+  glm::vec3 p[3];
+  glm::vec3 n[3];   // unit shading normals (flat normals when the mesh has none)
+  glm::vec2 uv[3];  // TEXCOORD_0, (0,0) when absent
+  std::uint32_t material = 0;
+};
+
+// A triangle with positions only: normals and texture coordinates zero (OBJ meshes, tests, benchmarks).
+inline Triangle makeTriangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, std::uint32_t material = 0) {
+  Triangle t{};
+  t.p[0] = a;
+  t.p[1] = b;
+  t.p[2] = c;
+  t.material = material;
+  return t;
+}
+
+// Pinhole camera. Looks down -Z of its node in glTF; here stored in world space.
+struct Camera {
+  std::string name;
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit
+  glm::vec3 up{0.0f, 1.0f, 0.0f};        // unit, orthogonal to forward
+  float yfov = 0.7f;                      // vertical field of view, radians
+  float aspect = 0.0f;                    // width / height from the file; 0 = take it from the image
+};
+
+struct Bounds {
+  glm::vec3 min{std::numeric_limits<float>::infinity()};
+  glm::vec3 max{-std::numeric_limits<float>::infinity()};
+  void grow(const glm::vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
+  bool empty() const { return min.x > max.x; }
+};
+
+struct Scene {
+  std::string path;                  // file it was loaded from
+  std::vector<Triangle> triangles;
+  std::vector<Material> materials;   // never empty after loading (a default diffuse is added if needed)
+  std::vector<Texture> textures;
+  std::vector<Camera> cameras;       // perspective cameras in the default scene's node-visit order (may be empty)
+  std::vector<std::string> warnings; // things skipped or approximated, each naming the file
+  Bounds bounds;
+};
+
+// Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
+Scene loadScene(const std::string& path);
+
+// A camera that frames the scene bounds (used when the file has none), looking down -Z.
+Camera autoCamera(const Bounds& bounds);
+
+}  // namespace caustica

@@ -1,0 +1,570 @@
+// bvh_test.cpp — tests of the watertight ray–triangle test, the binned-SAH BVH builder (structural
+// invariants, depth bound on adversarial input) and the C++ traversal against brute force.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "scene/obj_mesh.h"
+#include "util/error.h"
+
+using namespace caustica;
+
+namespace {
+
+const float kInf = std::numeric_limits<float>::infinity();
+
+
+std::vector<Triangle> loadBunny() {
+  return loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+}
+
+struct Rng {
+  std::mt19937 gen;
+  explicit Rng(unsigned seed) : gen(seed) {}
+  float uniform(float a = 0.0f, float b = 1.0f) { return std::uniform_real_distribution<float>(a, b)(gen); }
+  int index(int n) { return std::uniform_int_distribution<int>(0, n - 1)(gen); }
+  glm::vec3 inBox(glm::vec3 lo, glm::vec3 hi) {
+    return {uniform(lo.x, hi.x), uniform(lo.y, hi.y), uniform(lo.z, hi.z)};
+  }
+  glm::vec3 onSphere() {
+    float z = uniform(-1.0f, 1.0f), phi = uniform(0.0f, 6.2831853f), r = std::sqrt(std::max(0.0f, 1 - z * z));
+    return {r * std::cos(phi), r * std::sin(phi), z};
+  }
+};
+
+Bounds boundsOf(const std::vector<Triangle>& tris) {
+  Bounds b;
+  for (const Triangle& t : tris)
+    for (const glm::vec3& p : t.p) b.grow(p);
+  return b;
+}
+
+Ray makeRay(glm::vec3 o, glm::vec3 d) {
+  Ray r;
+  r.origin = o;
+  r.dir = d;
+  return r;
+}
+
+// Brute force over all triangles (same intersection routine; the reference for the traversal).
+Hit bruteClosest(const std::vector<gpu::TriGeom>& tris, const Ray& ray, float tmax) {
+  Hit best;
+  float closest = tmax;
+  for (std::uint32_t i = 0; i < tris.size(); ++i) {
+    float t, u, v;
+    if (intersectTriangle(ray, glm::vec3(tris[i].v0), glm::vec3(tris[i].v1), glm::vec3(tris[i].v2), closest, t, u, v)) {
+      closest = t;
+      best.t = t;
+      best.u = u;
+      best.v = v;
+      best.tri = i;
+    }
+  }
+  return best;
+}
+
+// Traces every ray with the BVH and by brute force; returns the number of disagreements (closest hit
+// found/t/u/v, and traceOccluded against brute-force any-hit at a few tmax values).
+int countMismatches(const std::vector<Triangle>& triangles, const std::vector<Ray>& rays, int* hits = nullptr) {
+  const Bvh bvh = buildBvh(triangles);
+  const std::vector<gpu::TriGeom> geom = packTriGeom(triangles, bvh);
+  int bad = 0, found = 0;
+  for (std::size_t r = 0; r < rays.size(); ++r) {
+    const Ray& ray = rays[r];
+    const Hit a = traceClosest(bvh.nodes, geom, ray);
+    const Hit b = bruteClosest(geom, ray, kInf);
+    bool ok = a.found() == b.found();
+    if (ok && a.found()) {
+      found++;
+      // Equal t; a different triangle is fine only if it is a tie (its own hit has the same t).
+      float t, u, v;
+      const gpu::TriGeom& g = geom[a.tri];
+      const bool self = intersectTriangle(ray, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), kInf, t, u, v);
+      ok = a.t == b.t && self && t == a.t && u == a.u && v == a.v;
+    }
+    // tmax = closest t must give "not occluded"; tmax within rounding of a hit distance is ill-posed
+    // (the watertight test's t carries an absolute error), so the other values stay clear of it.
+    const float tOcc[] = {kInf, b.found() ? 0.5f * b.t : 1.0f, b.found() ? b.t : 10.0f, b.found() ? 2.0f * b.t : 0.1f};
+    // Brute-force any-hit: some triangle has 0 < t < tmax exactly when the smallest such t is < tmax.
+    for (float tmax : tOcc) ok = ok && traceOccluded(bvh.nodes, geom, ray, tmax) == (b.found() && b.t < tmax);
+    if (!ok) {
+      if (bad < 5)
+        MESSAGE("mismatch ray " << r << " o=(" << ray.origin.x << "," << ray.origin.y << "," << ray.origin.z
+                                << ") d=(" << ray.dir.x << "," << ray.dir.y << "," << ray.dir.z << ") bvh t=" << a.t
+                                << " tri=" << a.tri << " brute t=" << b.t << " tri=" << b.tri);
+      bad++;
+    }
+  }
+  if (hits) *hits = found;
+  return bad;
+}
+
+// Half random rays through an enlarged bounding box, half aimed at random points on random triangles.
+std::vector<Ray> mixedRays(const std::vector<Triangle>& tris, int count, Rng& rng) {
+  const Bounds b = boundsOf(tris);
+  const glm::vec3 c = 0.5f * (b.min + b.max), h = 0.75f * (b.max - b.min) + 1e-3f;
+  std::vector<Ray> rays;
+  for (int i = 0; i < count; ++i) {
+    const glm::vec3 o = rng.inBox(c - 2.0f * h, c + 2.0f * h);
+    if (i % 2 == 0) {
+      rays.push_back(makeRay(o, rng.onSphere()));
+    } else {
+      const Triangle& t = tris[rng.index(int(tris.size()))];
+      float u = rng.uniform(), v = rng.uniform();
+      if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
+      const glm::vec3 target = t.p[0] + u * (t.p[1] - t.p[0]) + v * (t.p[2] - t.p[0]);
+      rays.push_back(makeRay(o, target - o));
+    }
+  }
+  return rays;
+}
+
+// Axis-aligned box as 12 triangles.
+void addBox(std::vector<Triangle>& out, glm::vec3 lo, glm::vec3 hi) {
+  const glm::vec3 v[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
+                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+  const int f[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+  for (const auto& q : f) {
+    out.push_back(makeTriangle(v[q[0]], v[q[1]], v[q[2]]));
+    out.push_back(makeTriangle(v[q[0]], v[q[2]], v[q[3]]));
+  }
+}
+
+// Cornell-box-like scene: open box [0,1]^3 without its front (z = 1) face, two blocks, a light quad.
+std::vector<Triangle> cornellBox() {
+  std::vector<Triangle> tris;
+  auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+    tris.push_back(makeTriangle(a, b, c));
+    tris.push_back(makeTriangle(a, c, d));
+  };
+  quad({0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1});  // floor
+  quad({0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0});  // ceiling
+  quad({0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0});  // back
+  quad({0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0});  // left
+  quad({1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1});  // right
+  quad({0.375f, 0.99f, 0.375f}, {0.625f, 0.99f, 0.375f}, {0.625f, 0.99f, 0.625f}, {0.375f, 0.99f, 0.625f});  // light
+  addBox(tris, {0.125f, 0.0f, 0.5f}, {0.5f, 0.25f, 0.875f});
+  addBox(tris, {0.5f, 0.0f, 0.125f}, {0.875f, 0.625f, 0.5f});
+  return tris;
+}
+
+std::vector<Triangle> randomSoup(int count, Rng& rng) {
+  std::vector<Triangle> tris;
+  for (int i = 0; i < count; ++i) {
+    const glm::vec3 c = rng.inBox(glm::vec3(-1.0f), glm::vec3(1.0f));
+    const float size = std::pow(10.0f, rng.uniform(-3.0f, -0.3f));
+    tris.push_back(makeTriangle(c + size * rng.onSphere(), c + size * rng.onSphere(), c + size * rng.onSphere()));
+  }
+  return tris;
+}
+
+// Exactly degenerate triangles: repeated vertices, one point, collinear on small-integer multiples.
+std::vector<Triangle> degenerateTriangles(int count, Rng& rng) {
+  std::vector<Triangle> tris;
+  for (int i = 0; i < count; ++i) {
+    const glm::vec3 p = glm::floor(rng.inBox(glm::vec3(-8.0f), glm::vec3(8.0f))) * 0.125f;
+    const glm::vec3 d = glm::floor(rng.inBox(glm::vec3(-4.0f), glm::vec3(4.0f))) * 0.0625f;
+    const glm::vec3 q = rng.inBox(glm::vec3(-1.0f), glm::vec3(1.0f));
+    switch (i % 4) {
+      case 0: tris.push_back(makeTriangle(p, p, q)); break;
+      case 1: tris.push_back(makeTriangle(q, p, p)); break;
+      case 2: tris.push_back(makeTriangle(p, p, p)); break;
+      default: tris.push_back(makeTriangle(p, p + d, p + 3.0f * d)); break;
+    }
+  }
+  return tris;
+}
+
+// Triangles with an infinite or NaN coordinate (they must never hit, and must not upset the BVH).
+std::vector<Triangle> nonFiniteTriangles(int count, Rng& rng) {
+  const float bad[] = {kInf, -kInf, std::numeric_limits<float>::quiet_NaN()};
+  std::vector<Triangle> tris;
+  for (int i = 0; i < count; ++i) {
+    Triangle t = makeTriangle(rng.onSphere(), rng.onSphere(), rng.onSphere());
+    t.p[i % 3][(i / 3) % 3] = bad[(i / 9) % 3];
+    tris.push_back(t);
+  }
+  return tris;
+}
+
+// Checks the structural invariants of a BVH built over tris.
+void checkStructure(const Bvh& bvh, const std::vector<Triangle>& tris, int maxLeafSize) {
+  const std::size_t n = tris.size();
+  REQUIRE(bvh.order.size() == n);
+  std::vector<int> seen(n, 0);
+  for (std::uint32_t i : bvh.order) {
+    if (i >= n) FAIL("order holds an index out of range: " << i);
+    seen[i]++;
+  }
+  CHECK(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(n));  // a permutation
+  REQUIRE(!bvh.nodes.empty());
+  CHECK(bvh.nodes.size() == std::size_t(2 * bvh.leafCount - 1));
+  CHECK(std::isfinite(bvh.sahCost));
+  CHECK(bvh.sahCost >= 0.0f);
+
+  std::vector<int> covered(n, 0), visited(bvh.nodes.size(), 0);
+  struct Item { std::uint32_t node; int depth; };
+  std::vector<Item> stack{{0, 1}};
+  int maxDepth = 0, leaves = 0, badBox = 0, badChild = 0, badLeaf = 0;
+  auto inside = [](glm::vec3 p, const gpu::BvhNode& b) {
+    return p.x >= b.bmin.x && p.y >= b.bmin.y && p.z >= b.bmin.z && p.x <= b.bmax.x && p.y <= b.bmax.y && p.z <= b.bmax.z;
+  };
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    if (it.node >= bvh.nodes.size() || visited[it.node]++ != 0)  // a tree: every node reached once
+      FAIL("node " << it.node << " out of range or reached twice");
+    const gpu::BvhNode& node = bvh.nodes[it.node];
+    maxDepth = std::max(maxDepth, it.depth);
+    if (node.triCount > 0) {
+      leaves++;
+      if (int(node.triCount) > maxLeafSize) badLeaf++;
+      if (std::size_t(node.leftFirst) + node.triCount > n) FAIL("leaf range out of bounds");
+      for (std::uint32_t i = node.leftFirst; i < node.leftFirst + node.triCount; ++i) {
+        covered[i]++;
+        for (const glm::vec3& p : tris[bvh.order[i]].p)
+          if (!inside(p, node)) badBox++;
+      }
+    } else {
+      if (node.leftFirst <= it.node || std::size_t(node.leftFirst) + 1 >= bvh.nodes.size())
+        FAIL("bad children of node " << it.node);
+      for (std::uint32_t c = node.leftFirst; c <= node.leftFirst + 1; ++c) {
+        const gpu::BvhNode& child = bvh.nodes[c];
+        if (!inside(child.bmin, node) || !inside(child.bmax, node)) badChild++;
+        stack.push_back({c, it.depth + 1});
+      }
+    }
+  }
+  CHECK(std::count(visited.begin(), visited.end(), 1) == std::ptrdiff_t(bvh.nodes.size()));
+  CHECK(std::count(covered.begin(), covered.end(), 1) == std::ptrdiff_t(n));  // leaves partition [0, n)
+  CHECK(badBox == 0);
+  CHECK(badChild == 0);
+  CHECK(badLeaf == 0);
+  CHECK(leaves == bvh.leafCount);
+  CHECK(maxDepth == bvh.depth);
+  CHECK(bvh.depth < CAUSTICA_BVH_STACK);
+}
+
+}  // namespace
+
+TEST_CASE("intersectTriangle: hand-made hits and misses") {
+  const glm::vec3 p0(0, 0, 0), p1(1, 0, 0), p2(0, 1, 0);
+  float t = -1, u = -1, v = -1;
+  REQUIRE(intersectTriangle(makeRay({0.25f, 0.5f, 1}, {0, 0, -1}), p0, p1, p2, kInf, t, u, v));
+  CHECK(t == doctest::Approx(1.0f));
+  CHECK(u == doctest::Approx(0.25f));  // weight of p1 = x
+  CHECK(v == doctest::Approx(0.5f));   // weight of p2 = y
+  CHECK(intersectTriangle(makeRay({0.25f, 0.5f, -2}, {0, 0, 1}), p0, p1, p2, kInf, t, u, v));  // back face
+  CHECK(t == doctest::Approx(2.0f));
+  CHECK(intersectTriangle(makeRay({0.25f, 0.5f, 1}, {0, 0, -4}), p0, p1, p2, kInf, t, u, v));  // t in |dir| units
+  CHECK(t == doctest::Approx(0.25f));
+  CHECK_FALSE(intersectTriangle(makeRay({0.75f, 0.75f, 1}, {0, 0, -1}), p0, p1, p2, kInf, t, u, v));  // outside
+  CHECK_FALSE(intersectTriangle(makeRay({0.25f, 0.5f, 1}, {0, 0, 1}), p0, p1, p2, kInf, t, u, v));    // behind
+  CHECK_FALSE(intersectTriangle(makeRay({0.25f, 0.5f, 1}, {0, 0, -1}), p0, p1, p2, 0.999f, t, u, v)); // beyond tmax
+  CHECK(intersectTriangle(makeRay({0.25f, 0.5f, 1}, {0, 0, -1}), p0, p1, p2, 1.001f, t, u, v));
+  CHECK_FALSE(intersectTriangle(makeRay({-1, 0.25f, 0}, {1, 0, 0}), p0, p1, p2, kInf, t, u, v));  // in plane
+  CHECK_FALSE(intersectTriangle(makeRay({0.25f, 0.5f, 1}, {0, 0, 0}), p0, p1, p2, kInf, t, u, v)); // zero dir
+  CHECK_FALSE(intersectTriangle(makeRay({0.25f, 0.5f, 0}, {0, 0, 1}), p0, p1, p2, kInf, t, u, v)); // t = 0
+  CHECK_FALSE(intersectTriangle(makeRay({0.25f, 0.5f, NAN}, {0, 0, -1}), p0, p1, p2, kInf, t, u, v));
+
+  // Random well-shaped triangles: the reported t, u, v reconstruct the aimed-at point.
+  Rng rng(7);
+  int bad = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 a = rng.onSphere(), b = rng.onSphere(), c = rng.onSphere();
+    if (glm::length(glm::cross(b - a, c - a)) < 0.2f) continue;
+    const float bu = rng.uniform(0.05f, 0.45f), bv = rng.uniform(0.05f, 0.45f);
+    const glm::vec3 target = a + bu * (b - a) + bv * (c - a);
+    const glm::vec3 o = 3.0f * rng.onSphere();
+    if (!intersectTriangle(makeRay(o, target - o), a, b, c, kInf, t, u, v) || std::fabs(t - 1.0f) > 1e-4f ||
+        std::fabs(u - bu) > 1e-4f || std::fabs(v - bv) > 1e-4f)
+      bad++;
+  }
+  CHECK(bad == 0);
+}
+
+TEST_CASE("intersectTriangle: watertight on shared edges and vertices") {
+  Rng rng(11);
+  // A gently curved 16 x 16 grid over [0,1]^2 with alternating diagonals.
+  const int n = 16;
+  std::vector<glm::vec3> grid((n + 1) * (n + 1));
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      grid[j * (n + 1) + i] = {i / float(n) + rng.uniform(-0.01f, 0.01f), j / float(n) + rng.uniform(-0.01f, 0.01f),
+                               0.05f * std::sin(7.0f * i / n) * std::cos(5.0f * j / n) + rng.uniform(-0.005f, 0.005f)};
+  std::vector<Triangle> tris;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 a = grid[j * (n + 1) + i], b = grid[j * (n + 1) + i + 1];
+      const glm::vec3 c = grid[(j + 1) * (n + 1) + i + 1], d = grid[(j + 1) * (n + 1) + i];
+      if ((i + j) % 2) {
+        tris.push_back(makeTriangle(a, b, c));
+        tris.push_back(makeTriangle(a, c, d));
+      } else {
+        tris.push_back(makeTriangle(a, b, d));
+        tris.push_back(makeTriangle(b, c, d));
+      }
+    }
+  // A closed fan around a centre vertex, slightly non-planar.
+  const glm::vec3 centre(0.3f, 0.6f, 2.0f);
+  std::vector<Triangle> fan;
+  const int spokes = 11;
+  for (int k = 0; k < spokes; ++k) {
+    auto ring = [&](int m) {
+      const float a = 6.2831853f * float(m % spokes) / spokes + 0.1f * std::sin(float(m % spokes));
+      return centre + glm::vec3(std::cos(a), std::sin(a), 0.1f * std::cos(3.0f * a));
+    };
+    fan.push_back(makeTriangle(centre, ring(k), ring(k + 1)));
+  }
+
+  auto anyHit = [](const std::vector<Triangle>& ts, const Ray& r) {
+    float t, u, v;
+    for (const Triangle& tri : ts)
+      if (intersectTriangle(r, tri.p[0], tri.p[1], tri.p[2], kInf, t, u, v)) return true;
+    return false;
+  };
+  // Origins above or below, within 60 degrees of the normal, from close by to far away.
+  auto origin = [&](glm::vec3 target) {
+    glm::vec3 d = rng.onSphere();
+    if (std::fabs(d.z) < 0.5f) d.z = d.z < 0 ? -0.5f : 0.5f;
+    return target + std::pow(10.0f, rng.uniform(-0.5f, 3.0f)) * glm::normalize(d);
+  };
+  int misses = 0, rays = 0;
+  for (int k = 0; k < 12000; ++k) {
+    const int i = 1 + rng.index(n - 1), j = 1 + rng.index(n - 1);  // interior vertex
+    const glm::vec3 vtx = grid[j * (n + 1) + i];
+    glm::vec3 target = vtx;
+    if (k % 3 == 1) target = glm::mix(vtx, grid[j * (n + 1) + i + 1], rng.uniform());         // on an edge
+    if (k % 3 == 2) target = glm::mix(vtx, grid[(j + 1) * (n + 1) + i], 0.5f);                  // edge midpoint
+    const glm::vec3 o = origin(target);
+    misses += !anyHit(tris, makeRay(o, target - o));
+    rays++;
+  }
+  for (int k = 0; k < 6000; ++k) {
+    const glm::vec3 o = origin(centre);
+    misses += !anyHit(fan, makeRay(o, centre - o));
+    rays++;
+  }
+  CHECK(rays == 18000);
+  CHECK(misses == 0);
+}
+
+TEST_CASE("intersectTriangle: degenerate and non-finite triangles never hit") {
+  Rng rng(5);
+  std::vector<Triangle> tris = degenerateTriangles(400, rng);
+  const std::vector<Triangle> bad = nonFiniteTriangles(100, rng);
+  tris.insert(tris.end(), bad.begin(), bad.end());
+  int hits = 0;
+  for (const Triangle& tri : tris)
+    for (int k = 0; k < 25; ++k) {
+      glm::vec3 target = glm::mix(tri.p[0], tri.p[2], float(k % 5) / 4.0f);
+      if (!std::isfinite(target.x + target.y + target.z)) target = tri.p[(k + 1) % 3];
+      const glm::vec3 o = target + 2.0f * rng.onSphere();
+      float t, u, v;
+      hits += intersectTriangle(makeRay(o, target - o), tri.p[0], tri.p[1], tri.p[2], kInf, t, u, v);
+    }
+  CHECK(hits == 0);
+}
+
+TEST_CASE("bvh: agrees with brute force on the bunny") {
+  const std::vector<Triangle> tris = loadBunny();
+  REQUIRE(tris.size() == 3674);
+  Rng rng(1);
+  int hits = 0;
+  CHECK(countMismatches(tris, mixedRays(tris, 15000, rng), &hits) == 0);
+  CHECK(hits > 7000);  // the aimed half hits
+}
+
+TEST_CASE("bvh: agrees with brute force on a Cornell box (axis-aligned and in-plane rays)") {
+  const std::vector<Triangle> tris = cornellBox();
+  Rng rng(2);
+  // Coordinates of every plane and edge in the scene, plus a few in between and outside.
+  const float coords[] = {-0.5f, 0.0f, 0.125f, 0.25f, 0.375f, 0.5f, 0.625f, 0.875f, 0.99f, 1.0f, 1.5f, 0.3f};
+  auto pick = [&]() { return rng.index(3) == 0 ? rng.uniform(-0.2f, 1.2f) : coords[rng.index(12)]; };
+  std::vector<Ray> rays;
+  for (int i = 0; i < 20000; ++i) {  // along +-x, +-y, +-z with exact (signed) zeros
+    const int axis = rng.index(3);
+    glm::vec3 d(rng.index(2) ? 0.0f : -0.0f, rng.index(2) ? 0.0f : -0.0f, rng.index(2) ? 0.0f : -0.0f);
+    d[axis] = rng.index(2) ? 1.0f : -1.0f;
+    rays.push_back(makeRay({pick(), pick(), pick()}, d));
+  }
+  for (int i = 0; i < 10000; ++i) {  // one zero direction component, origin on a face or edge plane
+    const int axis = rng.index(3);
+    glm::vec3 d = rng.onSphere();
+    d[axis] = rng.index(2) ? 0.0f : -0.0f;
+    glm::vec3 o = rng.inBox(glm::vec3(-0.2f), glm::vec3(1.2f));
+    o[axis] = coords[rng.index(12)];
+    rays.push_back(makeRay(o, d));
+  }
+  const std::vector<Ray> mixed = mixedRays(tris, 10000, rng);
+  rays.insert(rays.end(), mixed.begin(), mixed.end());
+  int hits = 0;
+  CHECK(countMismatches(tris, rays, &hits) == 0);
+  CHECK(hits > 20000);
+}
+
+TEST_CASE("bvh: agrees with brute force on a random triangle soup") {
+  Rng rng(3);
+  const std::vector<Triangle> tris = randomSoup(1000, rng);
+  int hits = 0;
+  CHECK(countMismatches(tris, mixedRays(tris, 25000, rng), &hits) == 0);
+  CHECK(hits > 12000);
+}
+
+TEST_CASE("bvh: agrees with brute force with degenerate, non-finite, huge and tiny triangles") {
+  Rng rng(4);
+  std::vector<Triangle> tris = randomSoup(200, rng);
+  const std::vector<Triangle> degenerate = degenerateTriangles(150, rng);
+  tris.insert(tris.end(), degenerate.begin(), degenerate.end());
+  for (int i = 0; i < 50; ++i) {  // slivers: collinear up to rounding
+    const glm::vec3 a = rng.inBox(glm::vec3(-1.0f), glm::vec3(1.0f)), d = 0.3f * rng.onSphere();
+    tris.push_back(makeTriangle(a, a + d, a + 2.0f * d + 1e-7f * rng.onSphere()));
+  }
+  const std::vector<Triangle> bad = nonFiniteTriangles(30, rng);
+  tris.insert(tris.end(), bad.begin(), bad.end());
+  for (int i = 0; i < 100; ++i) {  // huge: around 1e15 units away, 1e14 across
+    const glm::vec3 c = 1e15f * rng.onSphere();
+    tris.push_back(makeTriangle(c + 1e14f * rng.onSphere(), c + 1e14f * rng.onSphere(), c + 1e14f * rng.onSphere()));
+  }
+  for (int i = 0; i < 100; ++i) {  // tiny: within 1e-15 of the origin
+    const glm::vec3 c = 1e-15f * rng.onSphere();
+    tris.push_back(makeTriangle(c + 1e-16f * rng.onSphere(), c + 1e-16f * rng.onSphere(), c + 1e-16f * rng.onSphere()));
+  }
+  std::vector<Ray> rays;
+  for (int i = 0; i < 20000; ++i) {
+    const glm::vec3 o = (i % 4 == 3 ? 1e15f : 2.0f) * rng.inBox(glm::vec3(-1.0f), glm::vec3(1.0f));
+    const Triangle& t = tris[rng.index(int(tris.size()))];
+    const glm::vec3 target = (t.p[0] + t.p[1] + t.p[2]) / 3.0f;
+    rays.push_back(makeRay(o, i % 5 == 0 ? rng.onSphere() : target - o));
+  }
+  int hits = 0;
+  CHECK(countMismatches(tris, rays, &hits) == 0);
+  CHECK(hits > 5000);
+}
+
+TEST_CASE("bvh: structural invariants") {
+  SUBCASE("bunny, several build options") {
+    const std::vector<Triangle> tris = loadBunny();
+    for (int bins : {4, 16, 32})
+      for (int leaf : {1, 4, 8}) {
+        BvhBuildOptions opt;
+        opt.bins = bins;
+        opt.maxLeafSize = leaf;
+        checkStructure(buildBvh(tris, opt), tris, leaf);
+      }
+  }
+  SUBCASE("random soup and degenerate triangles") {
+    Rng rng(9);
+    std::vector<Triangle> tris = randomSoup(3000, rng);
+    const std::vector<Triangle> deg = degenerateTriangles(500, rng);
+    tris.insert(tris.end(), deg.begin(), deg.end());
+    checkStructure(buildBvh(tris), tris, BvhBuildOptions{}.maxLeafSize);
+  }
+  SUBCASE("100k identical triangles") {
+    const std::vector<Triangle> tris(100000, makeTriangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}));
+    const Bvh bvh = buildBvh(tris);
+    checkStructure(bvh, tris, BvhBuildOptions{}.maxLeafSize);
+    const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+    const Ray ray = makeRay({0.2f, 0.2f, 1.0f}, {0, 0, -1});
+    const Hit hit = traceClosest(bvh.nodes, geom, ray);
+    CHECK(hit.found());
+    CHECK(hit.t == bruteClosest(geom, ray, kInf).t);
+  }
+  SUBCASE("centroids on exponential sequences (SAH peels one cluster per level)") {
+    std::vector<Triangle> tris;
+    for (int k = 0; k < 140; ++k)  // x = 2^-k, 40 copies each
+      for (int c = 0; c < 40; ++c) {
+        const float x = std::ldexp(1.0f, -k), s = 0.25f * x;
+        tris.push_back(makeTriangle({x, 0, 0}, {x + s, 0, 0}, {x, s, s}));
+      }
+    for (int k = 0; k < 300; ++k) {  // x = 1.3^k up to ~1e34
+      const float x = std::pow(1.3f, float(k)), s = 0.1f * x;
+      tris.push_back(makeTriangle({x, 1, 0}, {x + s, 1, 0}, {x, 1 + s, s}));
+    }
+    for (int leaf : {1, 4}) {
+      BvhBuildOptions opt;
+      opt.maxLeafSize = leaf;
+      const Bvh bvh = buildBvh(tris, opt);
+      checkStructure(bvh, tris, leaf);
+      // Traversal still agrees with brute force on this tree.
+      const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+      Rng rng(10);
+      int bad = 0;
+      for (int i = 0; i < 300; ++i) {
+        const Triangle& t = tris[rng.index(int(tris.size()))];
+        const glm::vec3 target = (t.p[0] + t.p[1] + t.p[2]) / 3.0f, o = target + (target.x + 1.0f) * glm::vec3(0.1f, 0.2f, 3.0f);
+        const Ray ray = makeRay(o, target - o);
+        const Hit a = traceClosest(bvh.nodes, geom, ray), b = bruteClosest(geom, ray, kInf);
+        bad += a.found() != b.found() || a.t != b.t;
+      }
+      CHECK(bad == 0);
+    }
+  }
+}
+
+TEST_CASE("bvh: empty and single-triangle scenes") {
+  SUBCASE("no triangles") {
+    const std::vector<Triangle> tris;
+    const Bvh bvh = buildBvh(tris);
+    REQUIRE(bvh.nodes.size() == 1);
+    CHECK(bvh.order.empty());
+    CHECK(bvh.depth < CAUSTICA_BVH_STACK);
+    const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+    CHECK(geom.empty());
+    Rng rng(12);
+    for (int i = 0; i < 100; ++i) {
+      const Ray ray = makeRay(rng.inBox(glm::vec3(-1.0f), glm::vec3(1.0f)), rng.onSphere());
+      CHECK_FALSE(traceClosest(bvh.nodes, geom, ray).found());
+      CHECK_FALSE(traceOccluded(bvh.nodes, geom, ray, kInf));
+    }
+  }
+  SUBCASE("one triangle") {
+    const std::vector<Triangle> tris{makeTriangle({0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 7)};
+    const Bvh bvh = buildBvh(tris);
+    REQUIRE(bvh.nodes.size() == 1);
+    CHECK(bvh.nodes[0].triCount == 1);
+    const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+    REQUIRE(geom.size() == 1);
+    CHECK(glm::floatBitsToUint(geom[0].v0.w) == 7u);
+    const Hit hit = traceClosest(bvh.nodes, geom, makeRay({0.5f, 0.5f, 3}, {0, 0, -1}));
+    CHECK(hit.tri == 0u);
+    CHECK(hit.t == doctest::Approx(3.0f));
+    CHECK(hit.u == doctest::Approx(0.25f));
+    CHECK(hit.v == doctest::Approx(0.25f));
+    CHECK_FALSE(traceClosest(bvh.nodes, geom, makeRay({0.5f, 0.5f, 3}, {0, 0, 1})).found());
+    CHECK_FALSE(traceClosest(bvh.nodes, geom, makeRay({1.5f, 1.5f, 3}, {0, 0, -1})).found());
+    CHECK_FALSE(traceClosest(bvh.nodes, geom, makeRay({0.5f, 0.5f, 3}, {0, 0, -1}), 2.5f).found());
+    CHECK(traceOccluded(bvh.nodes, geom, makeRay({0.5f, 0.5f, 3}, {0, 0, -1}), 3.5f));
+    CHECK_FALSE(traceOccluded(bvh.nodes, geom, makeRay({0.5f, 0.5f, 3}, {0, 0, -1}), 2.5f));
+  }
+}
+
+TEST_CASE("bvh: packTriGeom follows the leaf order; bad options throw") {
+  Rng rng(13);
+  std::vector<Triangle> tris = randomSoup(500, rng);
+  for (std::size_t i = 0; i < tris.size(); ++i) tris[i].material = std::uint32_t(i * 3 + 1);
+  const Bvh bvh = buildBvh(tris);
+  const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+  int bad = 0;
+  for (std::size_t i = 0; i < geom.size(); ++i) {
+    const Triangle& t = tris[bvh.order[i]];
+    bad += glm::vec3(geom[i].v0) != t.p[0] || glm::vec3(geom[i].v1) != t.p[1] || glm::vec3(geom[i].v2) != t.p[2] ||
+           glm::floatBitsToUint(geom[i].v0.w) != t.material;
+  }
+  CHECK(bad == 0);
+  BvhBuildOptions opt;
+  opt.bins = 1;
+  CHECK_THROWS_AS(buildBvh(tris, opt), Error);
+  opt = BvhBuildOptions{};
+  opt.maxLeafSize = 0;
+  CHECK_THROWS_AS(buildBvh(tris, opt), Error);
+  CHECK_THROWS_AS(packTriGeom(std::vector<Triangle>(3), bvh), Error);
+}

@@ -1,0 +1,122 @@
+// gpu_scene_test.cpp — packing for the GPU: alias-table frequencies, emitter weights matching the
+// shader's lightPdfArea(), material conversion and feature detection.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "accel/gpu_scene.h"
+#include "shading/sampling.h"
+
+using namespace caustica;
+
+namespace {
+Triangle quadTri(float size, float y, std::uint32_t material, bool second) {
+  Triangle t{};
+  glm::vec3 a(-size, y, -size), b(size, y, -size), c(size, y, size), d(-size, y, size);
+  if (!second) {
+    t.p[0] = a; t.p[1] = c; t.p[2] = b;
+  } else {
+    t.p[0] = a; t.p[1] = d; t.p[2] = c;
+  }
+  for (auto& n : t.n) n = glm::vec3(0, -1, 0);
+  t.material = material;
+  return t;
+}
+}  // namespace
+
+TEST_CASE("alias table picks each item with probability proportional to its weight") {
+  std::vector<double> w = {1.0, 0.0, 7.5, 0.25, 3.0, 12.0, 0.01};
+  std::vector<std::uint32_t> items = {10, 11, 12, 13, 14, 15, 16};
+  auto table = buildAliasTable(w, items);
+  REQUIRE(table.size() == w.size());
+  double total = 0;
+  for (double x : w) total += x;
+  // Exact probabilities implied by the table: P(item) = sum over slots of (1/n)(prob or 1-prob).
+  std::vector<double> p(w.size(), 0.0);
+  for (size_t s = 0; s < table.size(); ++s) {
+    p[table[s].tri - 10] += table[s].prob / table.size();
+    p[table[table[s].alias].tri - 10] += (1.0 - table[s].prob) / table.size();
+  }
+  for (size_t i = 0; i < w.size(); ++i) {
+    CHECK(p[i] == doctest::Approx(w[i] / total).epsilon(1e-5));
+    CHECK(table[i].pdfSelect == doctest::Approx(w[i] / total).epsilon(1e-6));
+  }
+  // And sampling it the way lights.glsl does agrees (chi-square-like bound on counts).
+  std::uint32_t rng = 12345;
+  std::vector<int> counts(w.size(), 0);
+  const int n = 200000;
+  for (int k = 0; k < n; ++k) {
+    unsigned slot = std::min(static_cast<unsigned>(rand01(rng) * table.size()), static_cast<unsigned>(table.size() - 1));
+    std::uint32_t tri = rand01(rng) < table[slot].prob ? table[slot].tri : table[table[slot].alias].tri;
+    counts[tri - 10]++;
+  }
+  for (size_t i = 0; i < w.size(); ++i) {
+    double expected = n * w[i] / total;
+    CHECK(std::abs(counts[i] - expected) <= 5.0 * std::sqrt(expected) + 1.0);
+  }
+}
+
+TEST_CASE("emitters: one alias slot per emissive triangle, weights luminance x area x sides") {
+  Scene s;
+  Material white;
+  white.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  Material light;
+  light.emission = glm::vec3(10.0f, 5.0f, 2.0f);
+  Material light2 = light;
+  light2.doubleSided = true;
+  s.materials = {white, light, light2};
+  s.triangles = {quadTri(1, 0, 0, false), quadTri(1, 0, 0, true), quadTri(0.5f, 1, 1, false), quadTri(0.5f, 1, 1, true),
+                 quadTri(0.25f, 1.5f, 2, false)};
+  Bvh bvh = buildBvh(s.triangles);
+  GpuScene g = packScene(s, bvh);
+  CHECK(g.emitters.size() == 3);
+  float lum = luminance(light.emission);
+  double expected = lum * (0.5 * 0.5 * 4) + lum * (0.25 * 0.25 * 4 / 2) * 2;  // two halves of a 1x1 quad + double-sided half
+  CHECK(g.totalEmitterWeight == doctest::Approx(expected).epsilon(1e-5));
+  CHECK(g.totalPower == doctest::Approx(kPi * expected).epsilon(1e-5));
+  // The shader's per-area pdf lum*sides/total must equal pdfSelect/area for every slot.
+  for (const auto& e : g.emitters) {
+    const auto& t = g.triGeom[e.tri];
+    float area = 0.5f * glm::length(glm::cross(glm::vec3(t.v1 - t.v0), glm::vec3(t.v2 - t.v0)));
+    std::uint32_t mi = glm::floatBitsToUint(t.v0.w);
+    float sides = s.materials[mi].doubleSided ? 2.0f : 1.0f;
+    CHECK(e.pdfSelect / area == doctest::Approx(lum * sides / g.totalEmitterWeight).epsilon(1e-4));
+  }
+}
+
+TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, flags, features") {
+  Scene s;
+  Material glass;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  glass.dispersion = 0.5f;
+  glass.attenuationColor = glm::vec3(0.5f, 1.0f, 0.25f);
+  glass.attenuationDistance = 2.0f;
+  s.materials = {glass};
+  s.triangles = {quadTri(1, 0, 0, false)};
+  GpuScene g = packScene(s, buildBvh(s.triangles));
+  const gpu::Material& m = g.materials[0];
+  CHECK(m.absorption.x == doctest::Approx(std::log(2.0) / 2.0));
+  CHECK(m.absorption.y == doctest::Approx(0.0));
+  CHECK(m.absorption.z == doctest::Approx(std::log(4.0) / 2.0));
+  CHECK(m.absorption.w == doctest::Approx(40.0));  // V = 20 / dispersion
+  CHECK((m.tex.z & gpu::kMatHasVolume) != 0u);
+  CHECK((m.tex.z & gpu::kMatDispersive) != 0u);
+  CHECK(g.features.glass);
+  CHECK(g.features.volume);
+  CHECK(g.features.dispersion);
+  CHECK_FALSE(g.features.mirror);
+  CHECK_FALSE(g.features.textures);
+  CHECK(g.features.describe() == "glass volume dispersion");
+}
+
+TEST_CASE("a material no triangle uses does not switch features on") {
+  Scene s;
+  Material white, mirror;
+  mirror.metallic = 1.0f;
+  s.materials = {white, mirror};
+  s.triangles = {quadTri(1, 0, 0, false)};
+  CHECK_FALSE(sceneFeatures(s).mirror);
+  CHECK(sceneFeatures(s).defines().empty());
+}

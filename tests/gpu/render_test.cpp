@@ -1,0 +1,345 @@
+// render_test.cpp — accuracy of the path tracer against ground truth on llvmpipe: furnaces with known
+// answers, an invisible glass sphere, naive vs MIS agreement, a caustic where optics puts it, rgb vs
+// spectral dispersion, reproducibility, and no non-finite samples.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+
+#include "shading/sampling.h"
+#include "gl_test_util.h"
+
+using namespace caustica;
+using namespace caustica::test;
+
+namespace {
+
+RenderSettings small(int w, int h, Integrator integrator, std::uint32_t seed = 1) {
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.integrator = integrator;
+  s.seed = seed;
+  return s;
+}
+
+// Per-block means of several independent renders (different seeds) for a statistical comparison.
+struct BlockStats {
+  int blocksX = 0, blocksY = 0;
+  std::vector<double> mean, var;  // per block and channel: mean of the renders, variance of that mean
+};
+
+BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
+                      int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth,
+                      float casterProbability = 0.5f, std::vector<std::string>* defines = nullptr) {
+  BlockStats b;
+  b.blocksX = w / block;
+  b.blocksY = h / block;
+  size_t nb = static_cast<size_t>(b.blocksX) * b.blocksY * 3;
+  std::vector<std::vector<double>> per(renders, std::vector<double>(nb, 0.0));
+  for (int r = 0; r < renders; ++r) {
+    RenderSettings settings = small(w, h, integrator, seedBase + r);
+    settings.maxDepth = maxDepth;
+    settings.casterProbability = casterProbability;
+    RenderResult res = renderScene(scene, cam, settings, spp);
+    *nonFinite += res.stats.nonFinite;
+    if (defines) *defines = res.defines;
+    for (int y = 0; y < b.blocksY * block; ++y)
+      for (int x = 0; x < b.blocksX * block; ++x)
+        for (int c = 0; c < 3; ++c)
+          per[r][(static_cast<size_t>(y / block) * b.blocksX + x / block) * 3 + c] += res.image.at(x, y, c) / (block * block);
+  }
+  b.mean.assign(nb, 0.0);
+  b.var.assign(nb, 0.0);
+  for (size_t i = 0; i < nb; ++i) {
+    for (int r = 0; r < renders; ++r) b.mean[i] += per[r][i] / renders;
+    for (int r = 0; r < renders; ++r) b.var[i] += (per[r][i] - b.mean[i]) * (per[r][i] - b.mean[i]) / (renders - 1);
+    b.var[i] /= renders;  // variance of the mean
+  }
+  return b;
+}
+
+// Two estimators must agree within noise: per block, |difference| within 4.5 standard errors (plus a
+// small relative slack for the variance estimate's own noise), and the image means within 1.5 %.
+void checkBlocksAgree(const std::string& what, const BlockStats& a, const BlockStats& b) {
+  int bad = 0;
+  double sumA = 0, sumB = 0;
+  std::string worst;
+  for (size_t i = 0; i < a.mean.size(); ++i) {
+    double diff = std::abs(a.mean[i] - b.mean[i]);
+    double tol = 4.5 * std::sqrt(a.var[i] + b.var[i]) + 0.01 * std::max(a.mean[i], b.mean[i]) + 1e-4;
+    if (diff > tol) {
+      ++bad;
+      worst = "block " + std::to_string(i / 3) + " channel " + std::to_string(i % 3) + ": naive " +
+              std::to_string(a.mean[i]) + " mis " + std::to_string(b.mean[i]) + " tol " + std::to_string(tol);
+    }
+    sumA += a.mean[i];
+    sumB += b.mean[i];
+  }
+  INFO(what, ": ", bad, " of ", a.mean.size(), " block channels disagree; e.g. ", worst);
+  CHECK(bad <= 1);  // one in ~200 may fall outside 4.5 sigma with an estimated variance
+  CHECK(sumA / sumB == doctest::Approx(1.0).epsilon(0.015));
+}
+
+void checkEstimatorsAgree(const std::string& scenePath, int w, int h, int sppNaive, int sppMis, int maxDepth = 32) {
+  Scene scene = loadScene(sourcePath(scenePath));
+  Camera cam = sceneCamera(scene);
+  std::uint64_t nonFinite = 0;
+  const int block = 8, renders = 8;
+  BlockStats a = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 100, &nonFinite, maxDepth);
+  BlockStats b = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 200, &nonFinite, maxDepth);
+  checkBlocksAgree(scenePath, a, b);
+  CHECK(nonFinite == 0);
+}
+
+}  // namespace
+
+TEST_CASE("furnace: walls of albedo 0.5 emitting 1 give radiance 2 everywhere") {
+  for (const char* file : {"tests/data/scenes/furnace.gltf", "tests/data/scenes/furnace-glass.gltf"}) {
+    Scene scene = loadScene(sourcePath(file));
+    for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
+      RenderResult r = renderScene(scene, sceneCamera(scene), small(32, 32, integ), 64);
+      INFO(file, " ", std::string(integratorName(integ)));
+      for (int c = 0; c < 3; ++c) CHECK(meanOf(r.image, c) == doctest::Approx(2.0).epsilon(0.01));
+      int farOff = 0;
+      for (float v : r.image.rgb) farOff += std::abs(v - 2.0f) > 0.6f;
+      CHECK(farOff == 0);
+      CHECK(r.stats.nonFinite == 0);
+    }
+  }
+}
+
+TEST_CASE("a clear glass sphere inside a uniformly emitting black enclosure is invisible") {
+  Scene scene = loadScene(sourcePath("tests/data/scenes/glass-in-white-enclosure.gltf"));
+  for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
+    RenderSettings settings = small(32, 32, integ);
+    settings.maxDepth = 256;  // rays caught by total internal reflection near the rim need many bounces
+    RenderResult r = renderScene(scene, sceneCamera(scene), settings, 32);
+    INFO(std::string(integratorName(integ)));
+    CHECK(meanOf(r.image) == doctest::Approx(1.0).epsilon(0.003));
+    int off = 0;
+    float hi = 0.0f;
+    for (float v : r.image.rgb) {
+      off += std::abs(v - 1.0f) > 0.1f;
+      hi = std::max(hi, v);
+    }
+    // No dark silhouette, no bright rim: each path that leaves the glass carries exactly the
+    // enclosure's radiance. Only paths trapped at the rim of the tessellated sphere until the depth
+    // limit lose energy, in a few pixels.
+    CHECK(off <= static_cast<int>(r.image.rgb.size() / 100));
+    CHECK(hi < 1.02f);
+    CHECK(r.stats.nonFinite == 0);
+  }
+}
+
+TEST_CASE("naive and mis converge to the same image: Cornell box") {
+  checkEstimatorsAgree("assets/scenes/cornell-box.gltf", 32, 32, 256, 64);
+}
+
+TEST_CASE("naive and mis converge to the same image at a depth limit of 2: Cornell box") {
+  // Light sampling at the last allowed vertex would add light one bounce beyond the limit.
+  checkEstimatorsAgree("assets/scenes/cornell-box.gltf", 32, 32, 256, 64, 2);
+}
+
+TEST_CASE("naive and mis converge to the same image: glass and mirror spheres") {
+  checkEstimatorsAgree("tests/data/scenes/small-cornell.gltf", 32, 32, 256, 64);
+}
+
+TEST_CASE("naive and mis converge to the same image: bunny-shaped light") {
+  checkEstimatorsAgree("assets/scenes/cornell-bunny-light.gltf", 32, 32, 256, 64);
+}
+
+TEST_CASE("same seed, same image; another seed, another image") {
+  Scene scene = loadScene(sourcePath("tests/data/scenes/small-cornell.gltf"));
+  RenderResult a = renderScene(scene, sceneCamera(scene), small(16, 16, Integrator::Mis, 5), 4, 4);
+  RenderResult b = renderScene(scene, sceneCamera(scene), small(16, 16, Integrator::Mis, 5), 4, 1);  // other split
+  RenderResult c = renderScene(scene, sceneCamera(scene), small(16, 16, Integrator::Mis, 6), 4, 4);
+  double maxDiff = 0, otherDiff = 0;
+  for (size_t i = 0; i < a.image.rgb.size(); ++i) {
+    maxDiff = std::max(maxDiff, double(std::abs(a.image.rgb[i] - b.image.rgb[i])));
+    otherDiff = std::max(otherDiff, double(std::abs(a.image.rgb[i] - c.image.rgb[i])));
+  }
+  CHECK(maxDiff <= 1e-5);  // only the order of float additions may differ
+  CHECK(otherDiff > 1e-3);
+}
+
+namespace {
+
+void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material) {
+  // Counter-clockwise a, b, c, d seen from the front.
+  glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+  for (auto tri : {std::array<glm::vec3, 3>{a, b, c}, std::array<glm::vec3, 3>{a, c, d}}) {
+    Triangle t{};
+    for (int i = 0; i < 3; ++i) {
+      t.p[i] = tri[i];
+      t.n[i] = n;
+    }
+    t.material = material;
+    s.triangles.push_back(t);
+  }
+}
+
+void addSphere(Scene& s, glm::vec3 center, float radius, int segments, std::uint32_t material) {
+  auto point = [&](int i, int j) {
+    float theta = kPi * i / segments, phi = 2 * kPi * j / (2 * segments);
+    return glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
+  };
+  for (int i = 0; i < segments; ++i)
+    for (int j = 0; j < 2 * segments; ++j) {
+      glm::vec3 q[4] = {point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)};
+      for (auto idx : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+        Triangle t{};
+        for (int k = 0; k < 3; ++k) {
+          t.n[k] = q[idx[k]];
+          t.p[k] = center + radius * q[idx[k]];
+        }
+        if (glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) == 0.0f) continue;  // pole slivers
+        t.material = material;
+        s.triangles.push_back(t);
+      }
+    }
+}
+
+// A floor, a small light above it and a glass sphere between them whose focus lies on the floor.
+Scene causticScene(float dispersion) {
+  Scene s;
+  Material floor;
+  floor.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  Material light;
+  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  light.emission = glm::vec3(18.0f);
+  Material glass;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  glass.dispersion = dispersion;
+  s.materials = {floor, light, glass};
+  addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);  // floor, facing +y
+  float h = 0.15f;
+  addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);               // light, facing -y
+  addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
+  for (const auto& t : s.triangles)
+    for (const auto& p : t.p) s.bounds.grow(p);
+  Camera cam;
+  cam.position = {0.0f, 1.4f, 1.9f};
+  cam.forward = glm::normalize(glm::vec3(0.0f, 0.0f, 0.0f) - cam.position);
+  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
+  cam.yfov = 0.9f;
+  s.cameras.push_back(cam);
+  return s;
+}
+
+// Pixel of a world point for the renderer's pinhole camera (square image of size n).
+glm::ivec2 project(const Camera& cam, glm::vec3 p, int n) {
+  glm::vec3 f = glm::normalize(cam.forward), r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
+  glm::vec3 d = p - cam.position;
+  float t = std::tan(0.5f * cam.yfov);
+  float x = glm::dot(d, r) / glm::dot(d, f) / t, y = glm::dot(d, u) / glm::dot(d, f) / t;
+  return {static_cast<int>((x + 1) / 2 * n), static_cast<int>((1 - y) / 2 * n)};
+}
+
+double floorRadiance(const Image& img, const Camera& cam, float radius, float angle) {
+  glm::ivec2 px = project(cam, {radius * std::cos(angle), 0.0f, radius * std::sin(angle)}, img.width);
+  double sum = 0;
+  for (int c = 0; c < 3; ++c) sum += img.at(px.x, px.y, c) / 3.0;
+  return sum;
+}
+
+// Median or mean of the floor radiance over an annulus (the median is robust against the
+// fireflies of caustic paths).
+double floorAnnulus(const Image& img, const Camera& cam, float r0, float r1, bool median) {
+  std::vector<double> v;
+  for (float r = r0; r <= r1 + 1e-6f; r += (r1 - r0) / 4)
+    for (int k = 0; k < 48; ++k) v.push_back(floorRadiance(img, cam, r, 2 * kPi * k / 48));
+  if (!median) return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+TEST_CASE("the refraction caustic appears under the glass sphere, brighter than direct light, with both estimators") {
+  Scene scene = causticScene(0.0f);
+  const Camera& cam = scene.cameras[0];
+  const int n = 64;
+  for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
+    RenderResult r = renderScene(scene, cam, small(n, n, integ), 256);
+    // Focus: the floor straight under the sphere (the ball lens images the small light there).
+    // Shadow: the outer ring of the sphere's shadow (radius about 0.4), past the spread of the
+    // focused light: converged (naive 4096 spp, mis 1024 spp) it is 0.3 x the lit floor; the ring
+    // nearer the focus (0.18-0.26) is 0.7 x, lit by the lens. Lit: open floor.
+    double focus = 0;
+    glm::ivec2 c = project(cam, glm::vec3(0.0f), n);
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int ch = 0; ch < 3; ++ch) focus += r.image.at(c.x + dx, c.y + dy, ch) / 27.0;
+    double shadow = floorAnnulus(r.image, cam, 0.26f, 0.34f, true);
+    double lit = floorAnnulus(r.image, cam, 0.6f, 0.9f, false);
+    INFO(std::string(integratorName(integ)), ": focus ", focus, " shadow ", shadow, " lit ", lit);
+    CHECK(lit > 0.02);
+    CHECK(focus > 5.0 * lit);
+    CHECK(shadow < 0.5 * lit);
+    CHECK(r.stats.nonFinite == 0);
+  }
+}
+
+TEST_CASE("mis aiming at the glass ball (caustic casters) matches naive and finds the caustic with less noise") {
+  Scene scene = causticScene(0.0f);
+  const Camera& cam = scene.cameras[0];
+  const int n = 32, block = 4, renders = 8;
+  std::uint64_t nonFinite = 0;
+  std::vector<std::string> aimedDefines, plainDefines;
+  BlockStats naive = blockStats(scene, cam, Integrator::Naive, n, n, block, 256, renders, 300, &nonFinite, 32);
+  BlockStats aimed =
+      blockStats(scene, cam, Integrator::Mis, n, n, block, 64, renders, 400, &nonFinite, 32, 0.5f, &aimedDefines);
+  BlockStats plain =
+      blockStats(scene, cam, Integrator::Mis, n, n, block, 64, renders, 500, &nonFinite, 32, 0.0f, &plainDefines);
+  auto has = [](const std::vector<std::string>& d) { return std::count(d.begin(), d.end(), "CAUSTICA_CASTERS") > 0; };
+  REQUIRE(has(aimedDefines));
+  REQUIRE_FALSE(has(plainDefines));
+  checkBlocksAgree("caustic scene, naive against mis with casters", naive, aimed);
+  checkBlocksAgree("caustic scene, mis without casters against mis with casters", plain, aimed);
+  CHECK(nonFinite == 0);
+  // The focus under the ball and the blocks around it (3x3 blocks of 4x4 pixels): same samples per
+  // pixel, so the variance of the mean compares per sample.
+  glm::ivec2 c = project(cam, glm::vec3(0.0f), n) / block;
+  double varAimed = 0, varPlain = 0;
+  for (int by = c.y - 1; by <= c.y + 1; ++by)
+    for (int bx = c.x - 1; bx <= c.x + 1; ++bx)
+      for (int ch = 0; ch < 3; ++ch) {
+        size_t i = (static_cast<size_t>(by) * aimed.blocksX + bx) * 3 + ch;
+        varAimed += aimed.var[i];
+        varPlain += plain.var[i];
+      }
+  INFO("variance around the focus: with casters ", varAimed, ", without ", varPlain);
+  CHECK(varAimed < 0.5 * varPlain);
+}
+
+TEST_CASE("rgb and spectral dispersion agree in mean brightness, and spread the caustic into colours") {
+  Scene scene = causticScene(1.0f);
+  const int n = 48;
+  RenderSettings rgb = small(n, n, Integrator::Mis);
+  RenderSettings spectral = rgb;
+  spectral.dispersion = DispersionMode::Spectral;
+  RenderResult a = renderScene(scene, scene.cameras[0], rgb, 96);
+  RenderResult b = renderScene(scene, scene.cameras[0], spectral, 96);
+  for (int c = 0; c < 3; ++c) CHECK(meanOf(a.image, c) == doctest::Approx(meanOf(b.image, c)).epsilon(0.03));
+  CHECK(a.stats.nonFinite == 0);
+  CHECK(b.stats.nonFinite == 0);
+  // Without dispersion the whole image is grey (white light, grey floor); with it, some pixels are
+  // strongly coloured: the channels of the caustic separate.
+  auto maxChroma = [](const Image& img) {
+    double best = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        double r = img.at(x, y, 0), g = img.at(x, y, 1), bl = img.at(x, y, 2), m = (r + g + bl) / 3;
+        if (m > 0.05) best = std::max(best, (std::max({r, g, bl}) - std::min({r, g, bl})) / m);
+      }
+    return best;
+  };
+  RenderResult plain = renderScene(causticScene(0.0f), scene.cameras[0], rgb, 96);
+  INFO("chroma: plain ", maxChroma(plain.image), " rgb ", maxChroma(a.image), " spectral ", maxChroma(b.image));
+  CHECK(maxChroma(a.image) > 2.0 * maxChroma(plain.image) + 0.2);
+  CHECK(maxChroma(b.image) > 2.0 * maxChroma(plain.image) + 0.2);
+}

@@ -1,0 +1,776 @@
+// scene_test.cpp — tests of the glTF loader (app/core/scene_gltf.cpp): the shipped scenes, transforms,
+// accessor formats, the material contract, cameras, textures, and that bad input only ever throws
+// caustica::Error with a one-line message naming the file.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+#include <stb_image_write.h>
+
+#include "util/error.h"
+#include "scene/scene.h"
+
+namespace {
+
+using caustica::Scene;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr int kByte = 5121, kShort = 5123, kUint = 5125, kFloat = 5126;
+
+std::string source(const std::string& relative) { return std::string(CAUSTICA_SOURCE_DIR) + "/" + relative; }
+
+// A fresh directory under the system temp dir, removed at the end of the test.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    static int counter = 0;
+    path = fs::temp_directory_path() /
+           ("caustica_scene_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string write(const std::string& name, const std::string& bytes) const {
+    const fs::path file = path / name;
+    std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    return file.string();
+  }
+};
+
+std::string base64(const std::string& in) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  std::size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    const std::uint32_t v = std::uint32_t(std::uint8_t(in[i])) << 16 | std::uint32_t(std::uint8_t(in[i + 1])) << 8 |
+                            std::uint8_t(in[i + 2]);
+    for (int k = 3; k >= 0; --k) out += table[(v >> (6 * k)) & 63];
+  }
+  if (i < in.size()) {
+    std::uint32_t v = std::uint32_t(std::uint8_t(in[i])) << 16;
+    if (i + 1 < in.size()) v |= std::uint32_t(std::uint8_t(in[i + 1])) << 8;
+    out += table[(v >> 18) & 63];
+    out += table[(v >> 12) & 63];
+    out += i + 1 < in.size() ? table[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// Builds small glTF documents with one embedded buffer.
+struct Gltf {
+  json doc = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", json::array({{{"nodes", json::array()}}})}};
+  std::string bin;
+
+  template <class T>
+  int accessor(const std::vector<T>& values, int componentType, const char* type, bool normalized = false) {
+    while (bin.size() % 4) bin += '\0';
+    doc["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", values.size() * sizeof(T)}});
+    bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    const std::size_t components = std::string(type) == "SCALAR" ? 1 : std::size_t(type[3] - '0');
+    json acc = {{"bufferView", doc["bufferViews"].size() - 1},
+                {"componentType", componentType},
+                {"count", values.size() / components},
+                {"type", type}};
+    if (normalized) acc["normalized"] = true;
+    doc["accessors"].push_back(acc);
+    return int(doc["accessors"].size() - 1);
+  }
+  int positions(const std::vector<float>& xyz) { return accessor(xyz, kFloat, "VEC3"); }
+
+  int add(const char* array, const json& value) {
+    doc[array].push_back(value);
+    return int(doc[array].size() - 1);
+  }
+  int mesh(const json& primitive) { return add("meshes", {{"primitives", json::array({primitive})}}); }
+  int root(const json& node) {
+    const int index = add("nodes", node);
+    doc["scenes"][0]["nodes"].push_back(index);
+    return index;
+  }
+  int diffuse() { return add("materials", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}); }
+
+  std::string text() {
+    json d = doc;
+    d["buffers"] = json::array(
+        {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+    return d.dump();
+  }
+  Scene load(const TempDir& dir, const std::string& name = "scene.gltf") {
+    return caustica::loadScene(dir.write(name, text()));
+  }
+};
+
+// A unit right triangle in the z = 0 plane, counter-clockwise seen from +z, with normals +z.
+const std::vector<float> kTriangle = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+const std::vector<float> kTriangleNormals = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+
+glm::vec3 geometricNormal(const caustica::Triangle& t) {
+  return glm::normalize(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]));
+}
+
+bool near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) { return glm::length(a - b) <= eps; }
+
+// The error message for loading `path`, checking that only caustica::Error is thrown.
+std::string loadError(const std::string& path) {
+  try {
+    caustica::loadScene(path);
+  } catch (const caustica::Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    FAIL("non-caustica exception for ", path, ": ", e.what());
+  }
+  return "";
+}
+
+const caustica::Material* findMaterial(const Scene& s, const std::string& name) {
+  for (const auto& m : s.materials)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+bool hasWarning(const Scene& s, const std::string& text) {
+  for (const auto& w : s.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("every shipped scene loads with triangles, lights, a camera and consistent normals") {
+  const char* files[] = {"assets/scenes/cornell-box.gltf",          "assets/scenes/cornell-glass.gltf",
+                         "assets/scenes/cornell-bunny-light.gltf",  "assets/scenes/cornell-textured.gltf",
+                         "assets/scenes/cornell-dispersion.gltf",   "tests/data/scenes/furnace.gltf",
+                         "tests/data/scenes/furnace-glass.gltf",    "tests/data/scenes/glass-in-white-enclosure.gltf",
+                         "tests/data/scenes/small-cornell.gltf"};
+  for (const std::string file : files) {
+    CAPTURE(file);
+    const Scene s = caustica::loadScene(source(file));
+    CHECK(s.path == source(file));
+    CHECK(!s.triangles.empty());
+    CHECK(s.warnings.empty());
+    REQUIRE(s.cameras.size() == 1);
+    CHECK(!s.bounds.empty());
+    bool emissive = false;
+    for (const auto& m : s.materials) emissive = emissive || m.isEmissive();
+    CHECK(emissive);
+    std::size_t disagree = 0;
+    for (const auto& t : s.triangles) {
+      REQUIRE(t.material < s.materials.size());
+      const glm::vec3 g = geometricNormal(t);
+      for (const glm::vec3& n : t.n) {
+        CHECK(std::abs(glm::length(n) - 1.0f) < 1e-4f);
+        if (glm::dot(n, g) <= 0.0f) ++disagree;
+      }
+    }
+    CHECK(disagree == 0);  // winding and shading normals agree everywhere
+    const auto& cam = s.cameras[0];
+    CHECK(std::abs(glm::length(cam.forward) - 1.0f) < 1e-5f);
+    CHECK(std::abs(glm::dot(cam.forward, cam.up)) < 1e-5f);
+  }
+}
+
+TEST_CASE("Cornell walls face into the box and the ceiling light faces down") {
+  for (const char* file : {"assets/scenes/cornell-box.gltf", "assets/scenes/cornell-glass.gltf",
+                           "tests/data/scenes/small-cornell.gltf"}) {
+    CAPTURE(std::string(file));
+    const Scene s = caustica::loadScene(source(file));
+    const glm::vec3 centre(0.0f, 1.0f, 0.0f);
+    std::size_t walls = 0, lights = 0;
+    for (const auto& t : s.triangles) {
+      const glm::vec3 g = geometricNormal(t);
+      for (int axis = 0; axis < 3; ++axis) {
+        const float v = t.p[0][axis];
+        // A wall triangle is half of a 2 m x 2 m quad in a wall plane (box bottoms share the floor plane).
+        const float area = 0.5f * glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]));
+        const bool onWall = std::abs(std::abs(v - centre[axis]) - 1.0f) < 1e-5f && t.p[1][axis] == v &&
+                            t.p[2][axis] == v && std::abs(area - 2.0f) < 1e-4f;
+        if (onWall) {
+          ++walls;
+          CHECK(glm::dot(g, centre - t.p[0]) > 0.0f);
+        }
+      }
+      if (s.materials[t.material].isEmissive()) {
+        ++lights;
+        CHECK(near(g, glm::vec3(0.0f, -1.0f, 0.0f)));
+        CHECK(t.p[0].y < 2.0f);
+      }
+    }
+    CHECK(walls == 10);
+    CHECK(lights == 2);
+    const auto& cam = s.cameras[0];
+    CHECK(near(cam.forward, glm::vec3(0.0f, 0.0f, -1.0f)));
+    CHECK(cam.position.z > 1.0f);  // outside, looking in through the open side
+  }
+}
+
+TEST_CASE("cornell-glass: glass and mirror spheres and the classic light") {
+  const Scene s = caustica::loadScene(source("assets/scenes/cornell-glass.gltf"));
+  const auto* glass = findMaterial(s, "glass");
+  const auto* mirror = findMaterial(s, "mirror");
+  const auto* light = findMaterial(s, "light");
+  REQUIRE(glass);
+  REQUIRE(mirror);
+  REQUIRE(light);
+  CHECK(glass->transmission == 1.0f);
+  CHECK(glass->ior == doctest::Approx(1.5));
+  CHECK(glass->metallic == 0.0f);
+  CHECK(glass->roughness == 0.0f);
+  CHECK(std::isinf(glass->attenuationDistance));
+  CHECK(mirror->metallic == 1.0f);
+  CHECK(mirror->roughness == 0.0f);
+  CHECK(mirror->transmission == 0.0f);
+  CHECK(mirror->baseColor.r == doctest::Approx(0.95));
+  CHECK(light->emission.r == doctest::Approx(17.0).epsilon(1e-4));
+  CHECK(light->emission.g == doctest::Approx(12.0).epsilon(1e-4));
+  CHECK(light->emission.b == doctest::Approx(4.0).epsilon(1e-4));
+  CHECK(!light->doubleSided);
+  CHECK(s.cameras[0].yfov == doctest::Approx(0.6911));
+  CHECK(s.cameras[0].aspect == doctest::Approx(1.0));
+  // Sphere vertices lie on spheres of radius 0.35 resting on the floor.
+  std::size_t sphereTriangles = 0;
+  for (const auto& t : s.triangles) {
+    if (&s.materials[t.material] != glass) continue;
+    ++sphereTriangles;
+    for (const auto& p : t.p)
+      CHECK(glm::length(p - glm::vec3(-0.42f, 0.35f, 0.3f)) == doctest::Approx(0.35).epsilon(1e-4));
+  }
+  CHECK(sphereTriangles > 1000);
+}
+
+TEST_CASE("cornell-textured: textures decode with row 0 at the top and repeat") {
+  const Scene s = caustica::loadScene(source("assets/scenes/cornell-textured.gltf"));
+  REQUIRE(s.textures.size() == 2);
+  int textured = 0;
+  for (const auto& m : s.materials) {
+    if (m.baseColorTexture < 0) continue;
+    ++textured;
+    REQUIRE(m.baseColorTexture < int(s.textures.size()));
+    const auto& tex = s.textures[std::size_t(m.baseColorTexture)];
+    CHECK(tex.width == 128);
+    CHECK(tex.height == 128);
+    CHECK(tex.rgba.size() == 128u * 128u * 4u);
+    CHECK(tex.repeatS);
+    CHECK(tex.repeatT);
+    CHECK(!tex.mirrorS);
+  }
+  CHECK(textured == 2);
+  // The checkerboard (nearest filtering) is light grey at (0,0) and blue 16 texels to the right;
+  // the grid texture has a red mark in its top-left corner.
+  const auto& checker = s.textures[0].nearest ? s.textures[0] : s.textures[1];
+  const auto& grid = s.textures[0].nearest ? s.textures[1] : s.textures[0];
+  CHECK(checker.nearest);
+  CHECK(!grid.nearest);
+  CHECK(checker.rgba[0] == 220);
+  CHECK(checker.rgba[16 * 4 + 2] == 160);
+  CHECK(checker.rgba[3] == 255);
+  CHECK(grid.rgba[0] == 190);
+  CHECK(grid.rgba[1] == 40);
+  const std::size_t bottomLeft = std::size_t(127 * 128) * 4;
+  CHECK(grid.rgba[bottomLeft] != 190);
+  float maxU = 0.0f;
+  for (const auto& t : s.triangles)
+    for (const auto& uv : t.uv) maxU = std::max(maxU, uv.x);
+  CHECK(maxU > 1.5f);  // coordinates repeat the textures several times
+}
+
+TEST_CASE("cornell-dispersion, bunny light and furnaces follow the material contract") {
+  {
+    const Scene s = caustica::loadScene(source("assets/scenes/cornell-dispersion.gltf"));
+    const auto* prism = findMaterial(s, "dispersive glass");
+    REQUIRE(prism);
+    CHECK(prism->dispersion == doctest::Approx(1.2));
+    CHECK(prism->transmission == 1.0f);
+    int prismTriangles = 0;
+    for (const auto& t : s.triangles)
+      if (&s.materials[t.material] == prism && (t.p[0].x + t.p[1].x + t.p[2].x) / 3.0f > 0.35f) {
+        ++prismTriangles;  // the prism stands right of the sphere; it has no NORMAL: flat normals
+        for (const auto& n : t.n) CHECK(near(n, geometricNormal(t), 1e-4f));
+      }
+    CHECK(prismTriangles == 8);
+  }
+  {
+    const Scene s = caustica::loadScene(source("assets/scenes/cornell-bunny-light.gltf"));
+    std::size_t emitters = 0;
+    for (const auto& t : s.triangles)
+      if (s.materials[t.material].isEmissive()) {
+        ++emitters;
+        CHECK(s.materials[t.material].doubleSided);
+      }
+    CHECK(emitters == 3674);
+  }
+  for (const char* file : {"tests/data/scenes/furnace.gltf", "tests/data/scenes/furnace-glass.gltf",
+                           "tests/data/scenes/glass-in-white-enclosure.gltf"}) {
+    CAPTURE(std::string(file));
+    const Scene s = caustica::loadScene(source(file));
+    const float albedo = std::string(file).find("white") != std::string::npos ? 0.0f : 0.5f;
+    bool glass = false;
+    for (const auto& m : s.materials) {
+      if (m.transmission > 0.0f) {
+        glass = true;
+        CHECK(m.transmission == 1.0f);
+        CHECK(!m.isEmissive());
+        CHECK(m.baseColor == glm::vec4(1.0f));
+        continue;
+      }
+      CHECK(m.baseColor.r == doctest::Approx(albedo));
+      CHECK(m.metallic == 0.0f);
+      CHECK(m.emission == glm::vec3(1.0f));
+      CHECK(!m.doubleSided);
+    }
+    CHECK(glass == (std::string(file).find("glass") != std::string::npos));
+    const glm::vec3 eye = s.cameras[0].position;
+    CHECK(glm::all(glm::greaterThan(eye, s.bounds.min)));
+    CHECK(glm::all(glm::lessThan(eye, s.bounds.max)));
+    for (const auto& t : s.triangles)  // room walls face the camera inside
+      if (s.materials[t.material].isEmissive()) CHECK(glm::dot(geometricNormal(t), eye - t.p[0]) > 0.0f);
+  }
+}
+
+TEST_CASE("node transforms: negative scale flips the winding, normals use the inverse transpose") {
+  TempDir dir;
+  SUBCASE("negative scale") {
+    Gltf g;
+    const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)},
+                                             {"NORMAL", g.accessor(kTriangleNormals, kFloat, "VEC3")}}},
+                             {"material", g.diffuse()}});
+    g.root({{"mesh", mesh}, {"scale", {-1.0, 1.0, 1.0}}});
+    const Scene s = g.load(dir);
+    REQUIRE(s.triangles.size() == 1);
+    const auto& t = s.triangles[0];
+    CHECK(near(t.n[0], glm::vec3(0, 0, 1)));
+    CHECK(near(geometricNormal(t), glm::vec3(0, 0, 1)));  // mirrored, and re-wound to face +z
+    bool mirrored = false;
+    for (const auto& p : t.p) mirrored = mirrored || near(p, glm::vec3(-1, 0, 0));
+    CHECK(mirrored);
+  }
+  SUBCASE("rotation and non-uniform scale") {
+    // A triangle in the plane x + y = 1 with its true normal; scaled x2 along x, rotated 90 deg about z.
+    Gltf g;
+    const float r = std::sqrt(0.5f);
+    const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions({1, 0, 0, 0, 1, 0, 1, 0, 1})},
+                                             {"NORMAL", g.accessor(std::vector<float>{r, r, 0, r, r, 0, r, r, 0},
+                                                                   kFloat, "VEC3")}}},
+                             {"material", g.diffuse()}});
+    g.root({{"mesh", mesh}, {"rotation", {0.0, 0.0, r, r}}, {"scale", {2.0, 1.0, 1.0}}, {"translation", {0, 0, 5}}});
+    const Scene s = g.load(dir);
+    REQUIRE(s.triangles.size() == 1);
+    const auto& t = s.triangles[0];
+    CHECK(near(t.p[0], glm::vec3(0, 2, 5)));  // (1,0,0) -> scale (2,0,0) -> rotate (0,2,0) -> translate
+    for (const auto& n : t.n) {
+      CHECK(std::abs(glm::length(n) - 1.0f) < 1e-5f);
+      CHECK(near(n, geometricNormal(t)));  // a plain M * n would tilt the normal off the surface
+    }
+  }
+  SUBCASE("matrix equals TRS, and parents compose") {
+    Gltf g;
+    const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", g.diffuse()}});
+    // TRS: translation (1,2,3), rotation 90 deg about y, scale 2, as a column-major matrix.
+    g.root({{"mesh", mesh}, {"translation", {1, 2, 3}}, {"rotation", {0.0, std::sqrt(0.5), 0.0, std::sqrt(0.5)}},
+            {"scale", {2, 2, 2}}});
+    g.root({{"mesh", mesh}, {"matrix", {0, 0, -2, 0, 0, 2, 0, 0, 2, 0, 0, 0, 1, 2, 3, 1}}});
+    const int child = g.add("nodes", {{"mesh", mesh}, {"scale", {3, 3, 3}}});
+    g.root({{"translation", {0, 10, 0}}, {"children", {child}}});
+    const Scene s = g.load(dir);
+    REQUIRE(s.triangles.size() == 3);
+    for (int k = 0; k < 3; ++k) CHECK(near(s.triangles[0].p[k], s.triangles[1].p[k]));
+    CHECK(near(s.triangles[0].p[1], glm::vec3(1, 2, 1)));  // (1,0,0) -> (2,0,0) -> (0,0,-2) -> +T
+    CHECK(near(s.triangles[2].p[2], glm::vec3(0, 13, 0)));
+    CHECK(s.bounds.max.y == doctest::Approx(13.0));
+  }
+}
+
+TEST_CASE("primitives: index types, non-indexed, strips, fans, flat normals, degenerate triangles") {
+  TempDir dir;
+  const std::vector<float> quad = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  SUBCASE("all index component types give the same triangles") {
+    std::vector<std::vector<caustica::Triangle>> results;
+    for (int type : {kByte, kShort, kUint}) {
+      Gltf g;
+      int indices = -1;
+      if (type == kByte) indices = g.accessor(std::vector<std::uint8_t>{0, 1, 2, 0, 2, 3}, type, "SCALAR");
+      if (type == kShort) indices = g.accessor(std::vector<std::uint16_t>{0, 1, 2, 0, 2, 3}, type, "SCALAR");
+      if (type == kUint) indices = g.accessor(std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}, type, "SCALAR");
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(quad)}}}, {"indices", indices}})}});
+      const Scene s = g.load(dir);
+      REQUIRE(s.triangles.size() == 2);
+      results.push_back(s.triangles);
+    }
+    for (int k = 0; k < 3; ++k) {
+      CHECK(near(results[0][1].p[k], results[1][1].p[k]));
+      CHECK(near(results[0][1].p[k], results[2][1].p[k]));
+    }
+    CHECK(near(results[0][1].p[2], glm::vec3(0, 1, 0)));
+  }
+  SUBCASE("non-indexed triangles, flat normals when NORMAL is missing, default material") {
+    Gltf g;
+    g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions({0, 0, 0, 1, 0, 0, 0, 1, 0,  //
+                                                                       0, 0, 1, 0, 1, 1, 0, 0, 2})}}}})}});
+    const Scene s = g.load(dir);
+    REQUIRE(s.triangles.size() == 2);
+    CHECK(near(s.triangles[0].n[1], glm::vec3(0, 0, 1)));
+    CHECK(near(s.triangles[1].n[2], glm::vec3(1, 0, 0)));
+    REQUIRE(s.materials.size() == 1);
+    CHECK(s.materials[0].metallic == 0.0f);
+    CHECK(s.materials[0].baseColor.r == doctest::Approx(0.8));
+    CHECK(hasWarning(s, "no material"));
+  }
+  SUBCASE("triangle strip and fan keep every triangle facing +z") {
+    for (int mode : {5, 6}) {
+      Gltf g;
+      const std::vector<float> strip = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0};
+      const std::vector<float> fan = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0.5f, 2, 0, 0, 1, 0};
+      const int pos = g.positions(mode == 5 ? strip : fan);
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}}}, {"mode", mode}})}});
+      const Scene s = g.load(dir);
+      CHECK(s.triangles.size() == 3);
+      for (const auto& t : s.triangles) CHECK(near(geometricNormal(t), glm::vec3(0, 0, 1)));
+    }
+  }
+  SUBCASE("zero-area triangles are dropped with a warning; points are skipped with a warning") {
+    Gltf g;
+    const int pos = g.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0});
+    const int indices = g.accessor(std::vector<std::uint16_t>{0, 1, 2, 0, 1, 3}, kShort, "SCALAR");
+    json points = {{"attributes", {{"POSITION", pos}}}, {"mode", 0}};
+    json triangles = {{"attributes", {{"POSITION", pos}}}, {"indices", indices}};
+    g.doc["meshes"].push_back({{"primitives", {points, triangles}}});
+    g.root({{"mesh", 0}});
+    const Scene s = g.load(dir);
+    CHECK(s.triangles.size() == 1);
+    CHECK(hasWarning(s, "degenerate"));
+    CHECK(hasWarning(s, "POINTS"));
+  }
+}
+
+TEST_CASE("accessors: normalized texcoords and sparse substitution") {
+  TempDir dir;
+  SUBCASE("normalized UNSIGNED_BYTE and UNSIGNED_SHORT texcoords") {
+    for (int type : {kByte, kShort}) {
+      Gltf g;
+      const int uv = type == kByte ? g.accessor(std::vector<std::uint8_t>{0, 255, 51, 0, 255, 255}, type, "VEC2", true)
+                                   : g.accessor(std::vector<std::uint16_t>{0, 65535, 13107, 0, 65535, 65535}, type,
+                                                "VEC2", true);
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}, {"TEXCOORD_0", uv}}}})}});
+      const Scene s = g.load(dir);
+      REQUIRE(s.triangles.size() == 1);
+      CHECK(s.triangles[0].uv[0].x == doctest::Approx(0.0));
+      CHECK(s.triangles[0].uv[0].y == doctest::Approx(1.0));
+      CHECK(s.triangles[0].uv[1].x == doctest::Approx(0.2));
+      CHECK(s.triangles[0].uv[2].y == doctest::Approx(1.0));
+    }
+  }
+  SUBCASE("texcoords that are not normalized integers are rejected") {
+    Gltf g;
+    const int uv = g.accessor(std::vector<std::uint8_t>{0, 255, 51, 0, 255, 255}, kByte, "VEC2", false);
+    g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}, {"TEXCOORD_0", uv}}}})}});
+    const std::string error = loadError(dir.write("uv.gltf", g.text()));
+    CHECK(error.find("uv.gltf") != std::string::npos);
+    CHECK(error.find("TEXCOORD_0") != std::string::npos);
+  }
+  SUBCASE("sparse accessor over a bufferView and over zeros") {
+    // Vertices 1 and 2 are substituted; with or without the base data the result is the same.
+    for (bool withBase : {true, false}) {
+      CAPTURE(withBase);
+      Gltf g;
+      const int pos = g.positions(kTriangle);
+      const int sparseIndices = g.accessor(std::vector<std::uint8_t>{1, 2}, kByte, "SCALAR");
+      const int sparseValues = g.accessor(std::vector<float>{1, 0, 0, 0, 3, 0}, kFloat, "VEC3");
+      json acc = g.doc["accessors"][std::size_t(pos)];
+      if (!withBase) acc.erase("bufferView");
+      acc["sparse"] = {{"count", 2},
+                       {"indices", {{"bufferView", g.doc["accessors"][std::size_t(sparseIndices)]["bufferView"]},
+                                    {"componentType", kByte}}},
+                       {"values", {{"bufferView", g.doc["accessors"][std::size_t(sparseValues)]["bufferView"]}}}};
+      const int sparse = g.add("accessors", acc);
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", sparse}}}})}});
+      const Scene s = g.load(dir);
+      REQUIRE(s.triangles.size() == 1);
+      CHECK(near(s.triangles[0].p[0], glm::vec3(0, 0, 0)));
+      CHECK(near(s.triangles[0].p[1], glm::vec3(1, 0, 0)));
+      CHECK(near(s.triangles[0].p[2], glm::vec3(0, 3, 0)));
+    }
+  }
+}
+
+TEST_CASE("material contract: alpha modes, emission strength, glass extensions, defaults and warnings") {
+  TempDir dir;
+  Gltf g;
+  const int pos = g.positions(kTriangle);
+  auto material = [&](json m) {
+    const int index = g.add("materials", m);
+    g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}}}, {"material", index}})}});
+    return index;
+  };
+  json pbrAlpha = {{"baseColorFactor", {0.2, 0.4, 0.6, 0.3}}, {"metallicFactor", 0.0}};
+  material({{"name", "opaque"}, {"pbrMetallicRoughness", pbrAlpha}});
+  material({{"name", "blend"}, {"pbrMetallicRoughness", pbrAlpha}, {"alphaMode", "BLEND"}});
+  material({{"name", "mask-low"}, {"pbrMetallicRoughness", pbrAlpha}, {"alphaMode", "MASK"}});
+  material({{"name", "mask-high"}, {"pbrMetallicRoughness", pbrAlpha}, {"alphaMode", "MASK"}, {"alphaCutoff", 0.25}});
+  material({{"name", "emitter"},
+            {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+            {"emissiveFactor", {1.0, 0.5, 0.0}},
+            {"doubleSided", true},
+            {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4.0}}}}}});
+  material({{"name", "tinted glass"},
+            {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
+            {"extensions",
+             {{"KHR_materials_transmission", {{"transmissionFactor", 0.75}}},
+              {"KHR_materials_ior", {{"ior", 1.33}}},
+              {"KHR_materials_volume", {{"attenuationColor", {0.5, 0.9, 1.0}}, {"attenuationDistance", 0.2}}},
+              {"KHR_materials_dispersion", {{"dispersion", 0.5}}}}}});
+  material({{"name", "rough mirror"}, {"pbrMetallicRoughness", {{"metallicFactor", 0.6}, {"roughnessFactor", 0.4}}}});
+  material({{"name", "spec default"}});
+  g.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
+                             "KHR_materials_volume", "KHR_materials_dispersion", "EXT_something_else"};
+  const Scene s = g.load(dir);
+  REQUIRE(s.materials.size() == 8);
+  CHECK(findMaterial(s, "opaque")->baseColor.a == 1.0f);
+  CHECK(findMaterial(s, "opaque")->baseColor.b == doctest::Approx(0.6));
+  CHECK(findMaterial(s, "blend")->baseColor.a == doctest::Approx(0.3));
+  CHECK(findMaterial(s, "mask-low")->baseColor.a == 0.0f);  // 0.3 < default cutoff 0.5
+  CHECK(findMaterial(s, "mask-high")->baseColor.a == 1.0f);
+  const auto* emitter = findMaterial(s, "emitter");
+  CHECK(emitter->emission.r == doctest::Approx(4.0));
+  CHECK(emitter->emission.g == doctest::Approx(2.0));
+  CHECK(emitter->emission.b == 0.0f);
+  CHECK(emitter->doubleSided);
+  const auto* glass = findMaterial(s, "tinted glass");
+  CHECK(glass->transmission == doctest::Approx(0.75));
+  CHECK(glass->ior == doctest::Approx(1.33));
+  CHECK(glass->attenuationColor.r == doctest::Approx(0.5));
+  CHECK(glass->attenuationDistance == doctest::Approx(0.2));
+  CHECK(glass->dispersion == doctest::Approx(0.5));
+  CHECK(!glass->isEmissive());
+  CHECK(findMaterial(s, "rough mirror")->metallic == doctest::Approx(0.6));
+  const auto* spec = findMaterial(s, "spec default");  // glTF defaults: white, metallic 1, roughness 1
+  CHECK(spec->baseColor == glm::vec4(1.0f));
+  CHECK(spec->metallic == 1.0f);
+  CHECK(spec->roughness == 1.0f);
+  CHECK(spec->ior == doctest::Approx(1.5));
+  CHECK(std::isinf(spec->attenuationDistance));
+  CHECK(hasWarning(s, "'rough mirror'"));
+  CHECK(hasWarning(s, "'spec default'"));
+  CHECK(!hasWarning(s, "'tinted glass'"));
+  CHECK(hasWarning(s, "EXT_something_else"));
+  for (const auto& w : s.warnings) CHECK(w.rfind(s.path + ": ", 0) == 0);
+
+  SUBCASE("a required unsupported extension is an error") {
+    g.doc["extensionsUsed"] = {"KHR_texture_transform"};
+    g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+    const std::string error = loadError(dir.write("transform.gltf", g.text()));
+    CHECK(error.find("transform.gltf: ") != std::string::npos);
+    CHECK(error.find("KHR_texture_transform") != std::string::npos);
+  }
+}
+
+TEST_CASE("cameras: perspective parameters, world transform, traversal order, automatic camera") {
+  TempDir dir;
+  Gltf g;
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}})}});
+  g.add("cameras", {{"name", "second"}, {"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}});
+  g.add("cameras", {{"name", "first"},
+                    {"type", "perspective"},
+                    {"perspective", {{"yfov", 0.9}, {"aspectRatio", 1.5}, {"znear", 0.1}}}});
+  g.add("cameras", {{"name", "ortho"}, {"type", "orthographic"},
+                    {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}});
+  const double r = std::sqrt(0.5);
+  // "first" sits in a node that is traversed before the node holding "second", despite array order.
+  g.root({{"camera", 1}, {"translation", {1, 2, 3}}, {"rotation", {0.0, r, 0.0, r}}});  // 90 deg about +y
+  const int inner = g.add("nodes", {{"camera", 0}});
+  g.root({{"translation", {0, 0, 7}}, {"children", {inner}}});
+  g.root({{"camera", 2}});
+  const Scene s = g.load(dir);
+  REQUIRE(s.cameras.size() == 2);
+  CHECK(s.cameras[0].name == "first");
+  CHECK(s.cameras[0].yfov == doctest::Approx(0.9));
+  CHECK(s.cameras[0].aspect == doctest::Approx(1.5));
+  CHECK(near(s.cameras[0].position, glm::vec3(1, 2, 3)));
+  CHECK(near(s.cameras[0].forward, glm::vec3(-1, 0, 0)));  // -Z rotated 90 deg about +y
+  CHECK(near(s.cameras[0].up, glm::vec3(0, 1, 0)));
+  CHECK(s.cameras[1].name == "second");
+  CHECK(s.cameras[1].aspect == 0.0f);
+  CHECK(near(s.cameras[1].position, glm::vec3(0, 0, 7)));
+  CHECK(hasWarning(s, "orthographic"));
+
+  const caustica::Bounds bounds{glm::vec3(-1.0f, 0.0f, -3.0f), glm::vec3(1.0f, 2.0f, 1.0f)};
+  const caustica::Camera automatic = caustica::autoCamera(bounds);
+  CHECK(near(automatic.forward, glm::vec3(0, 0, -1)));
+  CHECK(near(automatic.up, glm::vec3(0, 1, 0)));
+  CHECK(automatic.yfov == doctest::Approx(40.0 * 3.14159265358979 / 180.0));
+  const float tanHalf = std::tan(automatic.yfov / 2.0f);
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) ? bounds.max.x : bounds.min.x, (corner & 2) ? bounds.max.y : bounds.min.y,
+                      (corner & 4) ? bounds.max.z : bounds.min.z);
+    const glm::vec3 d = p - automatic.position;
+    const float depth = glm::dot(d, automatic.forward);
+    REQUIRE(depth > 0.0f);
+    CHECK(std::abs(glm::dot(d, automatic.up)) <= tanHalf * depth * 1.0001f);
+    CHECK(std::abs(d.x) <= tanHalf * depth * 1.0001f);  // fits a square image too
+  }
+  const caustica::Camera fallback = caustica::autoCamera(caustica::Bounds{});
+  CHECK(std::isfinite(fallback.position.z));
+}
+
+TEST_CASE("textures: external PNG and JPEG files, samplers, emissive texture") {
+  TempDir dir;
+  // 2x2 RGBA PNG: top row red, green; bottom row blue, half-transparent white.
+  const unsigned char png[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+  REQUIRE(stbi_write_png((dir.path / "tiny.png").string().c_str(), 2, 2, 4, png, 8));
+  std::vector<unsigned char> jpeg(16 * 16 * 3);
+  for (std::size_t i = 0; i < jpeg.size(); i += 3) jpeg[i] = 200, jpeg[i + 1] = 100, jpeg[i + 2] = 50;
+  REQUIRE(stbi_write_jpg((dir.path / "flat.jpg").string().c_str(), 16, 16, 3, jpeg.data(), 100));
+
+  Gltf g;
+  g.doc["images"] = {{{"uri", "tiny.png"}}, {{"uri", "flat.jpg"}}};
+  g.doc["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}, {"magFilter", 9728}}};
+  g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}, {{"source", 1}}};
+  const int mat = g.add("materials",
+                        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}}},
+                         {"emissiveFactor", {1, 1, 1}},
+                         {"emissiveTexture", {{"index", 1}}}});
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", mat}})}});
+  const Scene s = g.load(dir);
+  REQUIRE(s.textures.size() == 2);
+  const auto& base = s.textures[std::size_t(s.materials[0].baseColorTexture)];
+  const auto& emissive = s.textures[std::size_t(s.materials[0].emissiveTexture)];
+  CHECK(base.width == 2);
+  CHECK(base.height == 2);
+  CHECK(std::vector<std::uint8_t>(base.rgba.begin(), base.rgba.end()) == std::vector<std::uint8_t>(png, png + 16));
+  CHECK(!base.repeatS);
+  CHECK(base.repeatT);
+  CHECK(base.mirrorT);
+  CHECK(base.nearest);
+  CHECK(emissive.width == 16);
+  CHECK(std::abs(int(emissive.rgba[0]) - 200) <= 3);
+  CHECK(std::abs(int(emissive.rgba[1]) - 100) <= 3);
+  CHECK(std::abs(int(emissive.rgba[2]) - 50) <= 3);
+  CHECK(emissive.rgba[3] == 255);
+  CHECK(emissive.repeatS);  // no sampler: REPEAT
+}
+
+TEST_CASE("external buffers: percent-encoded file names") {
+  TempDir dir;
+  Gltf g;
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}})}});
+  dir.write("my data.bin", g.bin);
+  json doc = g.doc;
+  doc["buffers"] = json::array({{{"byteLength", g.bin.size()}, {"uri", "my%20data.bin"}}});
+  const Scene s = caustica::loadScene(dir.write("external.gltf", doc.dump()));
+  REQUIRE(s.triangles.size() == 1);
+  CHECK(near(s.triangles[0].p[2], glm::vec3(0, 1, 0)));
+}
+
+TEST_CASE("bad input files throw caustica::Error naming the file and the problem") {
+  struct Case {
+    const char* file;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"not-a-scene.txt", "unsupported file extension"},
+      {"truncated.gltf", "invalid JSON"},
+      {"not-json.gltf", "invalid JSON"},
+      {"deep-nesting.gltf", "nested"},
+      {"no-asset.gltf", "asset"},
+      {"wrong-version.gltf", "asset.version"},
+      {"string-for-number.gltf", "accessors[0].count"},
+      {"string-for-index.gltf", "nodes[0].mesh"},
+      {"unknown-required-extension.gltf", "EXT_caustica_unknown"},
+      {"lines-only.gltf", "no triangles"},
+      {"empty-scene.gltf", "no triangles"},
+      {"degenerate-only.gltf", "zero area"},
+      {"index-out-of-range.gltf", "index 99"},
+      {"accessor-overrun.gltf", "overrun"},
+      {"bufferview-overrun.gltf", "bufferViews[1]"},
+      {"bad-stride.gltf", "byteStride"},
+      {"bad-component-type.gltf", "component type"},
+      {"mesh-index-out-of-range.gltf", "mesh"},
+      {"material-index-out-of-range.gltf", "material"},
+      {"bad-alpha-mode.gltf", "alphaMode"},
+      {"nan-position.gltf", "NaN"},
+      {"inf-position.gltf", "infinite"},
+      {"cycle.gltf", "cycle"},
+      {"two-parents.gltf", "two parents"},
+      {"camera-yfov-zero.gltf", "yfov"},
+      {"camera-yfov-negative.gltf", "yfov"},
+      {"bad-sparse-index.gltf", "sparse"},
+      {"missing-bin.gltf", "missing.bin"},
+      {"bin-size-mismatch.gltf", "bin-size-mismatch.bin"},
+      {"missing-image.gltf", "missing.png"},
+      {"bad-image-data.gltf", "images[0]"},
+      {"bad-magic.glb", "magic"},
+      {"truncated.glb", "truncated"},
+      {"bin-chunk-overrun.glb", "BIN chunk"},
+      {"does-not-exist.gltf", "not found"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(std::string(c.file));
+    const std::string path = source(std::string("tests/data/bad/") + c.file);
+    const std::string error = loadError(path);
+    CHECK(error.rfind(path + ": ", 0) == 0);
+    CHECK(error.find(c.expected) != std::string::npos);
+    CHECK(error.find('\n') == std::string::npos);
+  }
+  TempDir dir;
+  fs::create_directories(dir.path / "folder.gltf");
+  CHECK(loadError((dir.path / "folder.gltf").string()).find("directory") != std::string::npos);
+  CHECK(loadError(dir.write("empty.glb", "")).find("empty") != std::string::npos);
+}
+
+TEST_CASE("mutated files only ever throw caustica::Error") {
+  // Truncations and byte flips of a small valid scene (JSON and GLB); each must load or throw
+  // caustica::Error (loadError fails the test on any other exception; a crash fails the run).
+  TempDir dir;
+  Gltf g;
+  const int indices = g.accessor(std::vector<std::uint16_t>{0, 1, 2}, kShort, "SCALAR");
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)},
+                                           {"NORMAL", g.accessor(kTriangleNormals, kFloat, "VEC3")}}},
+                           {"indices", indices},
+                           {"material", g.diffuse()}})}});
+  const std::string text = g.text();
+  json glbDoc = g.doc;
+  glbDoc["buffers"] = json::array({{{"byteLength", g.bin.size()}}});
+  std::string glbJson = glbDoc.dump();
+  while (glbJson.size() % 4) glbJson += ' ';
+  std::string bin = g.bin;
+  while (bin.size() % 4) bin += '\0';
+  auto u32 = [](std::size_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };  // little-endian host
+  const std::string glb = "glTF" + u32(2) + u32(12 + 8 + glbJson.size() + 8 + bin.size()) + u32(glbJson.size()) +
+                          "JSON" + glbJson + u32(bin.size()) + std::string("BIN\0", 4) + bin;
+  CHECK(caustica::loadScene(dir.write("valid.glb", glb)).triangles.size() == 1);
+  CHECK(caustica::loadScene(dir.write("valid.gltf", text)).triangles.size() == 1);
+
+  std::uint32_t seed = 12345;
+  auto next = [&seed] { return seed = seed * 1664525u + 1013904223u; };
+  int loaded = 0, rejected = 0;
+  for (const std::string* original : {&text, &glb}) {
+    const std::string ext = original == &glb ? ".glb" : ".gltf";
+    for (std::size_t cut = 0; cut < original->size(); cut += 13) {
+      const std::string error = loadError(dir.write("cut" + ext, original->substr(0, cut)));
+      (error.empty() ? loaded : rejected)++;
+    }
+    for (int trial = 0; trial < 150; ++trial) {
+      std::string bytes = *original;
+      for (int flips = 1 + int(next() % 3); flips > 0; --flips)
+        bytes[next() % bytes.size()] = char(next() >> 24);
+      const std::string error = loadError(dir.write("flip" + ext, bytes));
+      (error.empty() ? loaded : rejected)++;
+      if (!error.empty()) CHECK(error.find('\n') == std::string::npos);
+    }
+  }
+  CHECK(rejected > 0);
+  CHECK(loaded > 0);
+}

@@ -1,3 +1,0 @@
-// test_main.cpp — doctest entry point for the unit tests (no OpenGL needed).
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
-#include <doctest/doctest.h>
