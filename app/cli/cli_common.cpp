@@ -71,6 +71,12 @@ bool Options::parse(const std::vector<std::string>& args) {
   return true;
 }
 
+bool Options::isList(const std::string& name) const {
+  for (const auto& s : specs_)
+    if (s.name == name) return s.metavar == "LIST";
+  return false;
+}
+
 std::string Options::get(const std::string& name, const std::string& fallback) const {
   auto it = values_.find(name);
   return it == values_.end() ? fallback : it->second;
@@ -125,7 +131,8 @@ void parseSize(const std::string& text, float cameraAspect, int& width, int& hei
   auto num = [&](const std::string& s) {
     char* end = nullptr;
     long n = std::strtol(s.c_str(), &end, 10);
-    if (s.empty() || *end != '\0' || n < 1 || n > 16384) throw Error("bad --size '" + text + "' (expected W or WxH, 1 to 16384)");
+    if (s.empty() || *end != '\0' || n < 1 || n > kMaxImageSide)
+      throw Error("bad --size '" + text + "' (expected W or WxH, 1 to " + std::to_string(kMaxImageSide) + ")");
     return static_cast<int>(n);
   };
   if (x == std::string::npos) {
@@ -167,14 +174,14 @@ void note(bool quiet, const std::string& line) {
   if (!quiet) std::cerr << "caustica: " << line << "\n";
 }
 
-LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
-  if (opts.positional().size() > 1) throw Error("expected one scene, got " + std::to_string(opts.positional().size()));
-  std::string arg = opts.positional().empty() ? kDefaultScene : opts.positional()[0];
-  std::string path = resolveScenePath(arg);
+int cameraIndexFrom(const Options& opts) { return opts.getInt("--camera", 0, 0, 1 << 20); }
+
+LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose) {
+  std::string path = resolveScenePath(nameOrPath);
   LoadedScene ls;
   ls.scene = loadScene(path);
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
-  int index = opts.getInt("--camera", 0, 0, 1 << 20);
+  int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {
     if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");
     ls.camera = autoCamera(ls.scene.bounds);
@@ -187,24 +194,27 @@ LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
   return ls;
 }
 
-float casterProbabilityFrom(const Options& opts) {
-  float p = static_cast<float>(opts.getDouble("--caster-probability", RenderSettings{}.casterProbability));
-  if (!(p >= 0.0f && p <= kMaxCasterProbability)) {
+LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
+  if (opts.positional().size() > 1) throw Error("expected one scene, got " + std::to_string(opts.positional().size()));
+  return loadSceneForCli(opts.positional().empty() ? kDefaultScene : opts.positional()[0], opts, verbose);
+}
+
+RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
+  const RenderSettings defaults;
+  RenderSettings s;
+  parseSize(opts.get("--size", std::to_string(defaultWidth)), camera.aspect, s.width, s.height);
+  s.seed = static_cast<std::uint32_t>(opts.getInt("--seed", static_cast<int>(defaults.seed), 0, 2147483647));
+  s.maxDepth = opts.getInt("--max-depth", defaults.maxDepth, kMinMaxDepth, kMaxMaxDepth);
+  if (!opts.isList("--integrator")) s.integrator = parseIntegrator(opts.get("--integrator", integratorName(defaults.integrator)));
+  if (!opts.isList("--dispersion"))
+    s.dispersion = parseDispersionMode(opts.get("--dispersion", dispersionModeName(defaults.dispersion)));
+  s.casterProbability = static_cast<float>(opts.getDouble("--caster-probability", defaults.casterProbability));
+  if (!(s.casterProbability >= 0.0f && s.casterProbability <= kMaxCasterProbability)) {
     std::ostringstream m;
     m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
     throw Error(m.str());
   }
-  return p;
-}
-
-RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
-  RenderSettings s;
-  parseSize(opts.get("--size", std::to_string(defaultWidth)), camera.aspect, s.width, s.height);
-  s.seed = static_cast<std::uint32_t>(opts.getInt("--seed", 1, 0, 2147483647));
-  s.maxDepth = opts.getInt("--max-depth", 32, 1, 1024);
-  s.integrator = parseIntegrator(opts.get("--integrator", "mis"));
-  s.dispersion = parseDispersionMode(opts.get("--dispersion", "rgb"));
-  s.casterProbability = casterProbabilityFrom(opts);
+  s.validate();
   return s;
 }
 

@@ -31,6 +31,9 @@ class Options {
   int getInt(const std::string& name, int fallback, int lo, int hi) const;
   double getDouble(const std::string& name, double fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
+  // Whether this command declares `name` with metavar LIST (comma-separated values, e.g. bench's
+  // --dispersion rgb,spectral) rather than a single value.
+  bool isList(const std::string& name) const;
   std::string help() const;
 
  private:
@@ -52,11 +55,17 @@ struct LoadedScene {
   Scene scene;
   Camera camera;
 };
-// Loads the scene argument (bare name or path) and picks --camera N (default 0; automatic if none).
+// Loads `nameOrPath` (a bundled scene name or a file), prints its warnings when verbose, and picks
+// --camera N (default 0; a camera framing the scene if it has none).
+LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose);
+// The same for the command's one positional scene argument (default: the bundled default scene).
 LoadedScene loadSceneForCli(const Options& opts, bool verbose);
+int cameraIndexFrom(const Options& opts);  // --camera N, default 0
 
-// --caster-probability, checked (0 to 0.9; default 0.5).
-float casterProbabilityFrom(const Options& opts);
+// The one place the command line becomes RenderSettings (render, view and bench): --size (default
+// `defaultWidth`, height from the camera's aspect), --seed, --max-depth, --integrator, --dispersion,
+// --caster-probability, each checked with an error that names the option. An option the command
+// declares as a LIST (bench) is left at its default: the command sets it per run.
 RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth);
 ShaderLibrary shaderLibraryFrom(const Options& opts);
 

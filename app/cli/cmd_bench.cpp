@@ -216,24 +216,11 @@ class Bench {
  private:
   void benchScene(const ShaderLibrary& library, const std::string& path) {
     const std::string name = fs::path(path).stem().string();
-    Scene scene = loadScene(path);
-    for (const auto& w : scene.warnings) note(quiet_, "warning: " + w);
-    int cameraIndex = opts_.getInt("--camera", 0, 0, 1 << 20);
-    Camera camera;
-    if (scene.cameras.empty()) {
-      if (opts_.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");
-      camera = autoCamera(scene.bounds);
-    } else {
-      if (cameraIndex >= static_cast<int>(scene.cameras.size()))
-        throw Error(path + ": --camera " + std::to_string(cameraIndex) + " but the scene has " +
-                    std::to_string(scene.cameras.size()) + " camera(s)");
-      camera = scene.cameras[static_cast<size_t>(cameraIndex)];
-    }
-    RenderSettings settings;
-    parseSize(opts_.get("--size", "256"), camera.aspect, settings.width, settings.height);
-    settings.seed = static_cast<std::uint32_t>(opts_.getInt("--seed", 1, 0, 2147483647));
-    settings.maxDepth = opts_.getInt("--max-depth", 32, 1, 1024);
-    settings.casterProbability = casterProbabilityFrom(opts_);
+    LoadedScene ls = loadSceneForCli(path, opts_, !quiet_);
+    const Scene& scene = ls.scene;
+    const Camera& camera = ls.camera;
+    const int cameraIndex = cameraIndexFrom(opts_);
+    const RenderSettings settings = renderSettingsFrom(opts_, camera, 256);
 
     std::optional<PixelRect> caustic;
     auto info = sceneInfo_.find(name);
@@ -267,9 +254,10 @@ class Bench {
       std::string preview = (fs::path(outDir_) / (name + "-" + dispersionModeName(mode) + "-reference.png")).string();
       writeImage(preview, caustic ? outlined(ref.image, *caustic, 4.0f) : ref.image);
       for (Integrator integrator : integrators_) {  // reference() left the renderer in its own settings
-        renderer.setDispersionMode(mode);
-        renderer.setIntegrator(integrator);
-        renderer.setCasterProbability(settings.casterProbability);
+        RenderSettings run = settings;
+        run.dispersion = mode;
+        run.integrator = integrator;
+        renderer.apply(run);
         results.push_back(measure(renderer, name, ref, caustic));
       }
     }
@@ -306,9 +294,7 @@ class Bench {
     // The reference is one estimate of the image whatever the measured runs use: always mis with the
     // default caster probability, so --caster-probability runs (ablations) share the cached reference.
     rs.casterProbability = RenderSettings{}.casterProbability;
-    renderer.setDispersionMode(mode);
-    renderer.setIntegrator(Integrator::Mis);
-    renderer.setCasterProbability(rs.casterProbability);
+    renderer.apply(rs);  // for its shader variant, which is part of the cache key
     std::ostringstream key;
     key << kCacheVersion << '\n' << hex64(hashSceneFiles(path)) << '\n' << rs.width << 'x' << rs.height << '\n'
         << referenceSpp << " spp\nseed " << rs.seed << "\ndepth " << rs.maxDepth << '\n'

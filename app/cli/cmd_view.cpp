@@ -93,6 +93,7 @@ class Viewer {
   void renderWithin(double budgetMs, bool stopAtPassEnd = false);
   int choosePassSpp() const;
   void present();
+  bool resizeRenderer(int width, int height);  // true if the resolution changed (accumulation restarts)
   void finishPass();
   void updateTitle(bool force);
   void writeScreenshotPair();
@@ -108,11 +109,8 @@ class Viewer {
   std::unique_ptr<CameraController> controller_;
 
   // What the renderer should be doing (applied by syncRenderer, which pausing defers).
-  Integrator integrator_ = Integrator::Mis;
-  float casterProbability_ = RenderSettings{}.casterProbability;
+  RenderSettings wanted_;  // width and height aside: syncRenderer picks full or preview resolution
   float casterProbabilityOn_ = RenderSettings{}.casterProbability;  // what C switches back to
-  DispersionMode dispersion_ = DispersionMode::Rgb;
-  int maxDepth_ = 32;
   int fullW_ = 0, fullH_ = 0;          // full render resolution, pixels
   std::uint64_t appliedRevision_ = 0;  // controller revision the renderer has
   double exposure0_ = 0.0;
@@ -158,11 +156,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config) : config_(config) 
   scene_ = loadSceneForCli(opts, !config_.quiet);
   sceneName_ = fileStem(scene_.scene.path);
   RenderSettings settings = renderSettingsFrom(opts, scene_.camera, kDefaultWidth);
-  integrator_ = settings.integrator;
-  casterProbability_ = settings.casterProbability;
-  if (casterProbability_ > 0.0f) casterProbabilityOn_ = casterProbability_;
-  dispersion_ = settings.dispersion;
-  maxDepth_ = settings.maxDepth;
+  wanted_ = settings;
+  if (wanted_.casterProbability > 0.0f) casterProbabilityOn_ = wanted_.casterProbability;
   exposure0_ = config_.tone.exposureStops;
 
   std::string glInfo;
@@ -186,7 +181,7 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config) : config_(config) 
   appliedRevision_ = controller_->revision();
   note(config_.quiet, scene_.scene.path + ": " + std::to_string(scene_.scene.triangles.size()) + " triangles, features: " +
                           renderer_->gpuScene().features.describe() + "; " + std::to_string(fullW_) + "x" +
-                          std::to_string(fullH_) + ", " + integratorName(integrator_) + "; press H for the controls");
+                          std::to_string(fullH_) + ", " + integratorName(wanted_.integrator) + "; press H for the controls");
   window_->cursor(lastX_, lastY_);
   lastMotion_ = now();  // start like a camera change: a preview first if full passes are slow
 }
@@ -202,10 +197,12 @@ void Viewer::handleInput(double dt) {
       case GLFW_KEY_SPACE: paused_ = !paused_; break;
       case GLFW_KEY_R: controller_->reset(); break;
       case GLFW_KEY_F: fly_ = !fly_; break;
-      case GLFW_KEY_I: integrator_ = integrator_ == Integrator::Mis ? Integrator::Naive : Integrator::Mis; break;
-      case GLFW_KEY_C: casterProbability_ = casterProbability_ > 0.0f ? 0.0f : casterProbabilityOn_; break;
+      case GLFW_KEY_I:
+        wanted_.integrator = wanted_.integrator == Integrator::Mis ? Integrator::Naive : Integrator::Mis;
+        break;
+      case GLFW_KEY_C: wanted_.casterProbability = wanted_.casterProbability > 0.0f ? 0.0f : casterProbabilityOn_; break;
       case GLFW_KEY_L:
-        dispersion_ = dispersion_ == DispersionMode::Rgb ? DispersionMode::Spectral : DispersionMode::Rgb;
+        wanted_.dispersion = wanted_.dispersion == DispersionMode::Rgb ? DispersionMode::Spectral : DispersionMode::Rgb;
         break;
       case GLFW_KEY_T:
         config_.tone.curve = config_.tone.curve == ToneCurve::Aces ? ToneCurve::Clamp : ToneCurve::Aces;
@@ -224,10 +221,10 @@ void Viewer::handleInput(double dt) {
       const int n = static_cast<int>(sizeof kDepthSteps / sizeof kDepthSteps[0]);
       if (c == ']') {
         for (int i = 0; i < n; ++i)
-          if (kDepthSteps[i] > maxDepth_) { maxDepth_ = kDepthSteps[i]; break; }
+          if (kDepthSteps[i] > wanted_.maxDepth) { wanted_.maxDepth = kDepthSteps[i]; break; }
       } else {
         for (int i = n - 1; i >= 0; --i)
-          if (kDepthSteps[i] < maxDepth_) { maxDepth_ = kDepthSteps[i]; break; }
+          if (kDepthSteps[i] < wanted_.maxDepth) { wanted_.maxDepth = kDepthSteps[i]; break; }
       }
     } else {
       continue;
@@ -271,27 +268,13 @@ void Viewer::handleInput(double dt) {
 // ---- rendering -----------------------------------------------------------------------------------
 
 void Viewer::syncRenderer() {
-  bool restarted = false;
-  const RenderSettings& s = renderer_->settings();
-  if (s.integrator != integrator_) {
-    renderer_->setIntegrator(integrator_);
-    warmUp();
-    restarted = true;
-  }
-  if (s.casterProbability != casterProbability_) {
-    renderer_->setCasterProbability(casterProbability_);
-    warmUp();
-    restarted = true;
-  }
-  if (s.dispersion != dispersion_) {
-    renderer_->setDispersionMode(dispersion_);
-    warmUp();
-    restarted = true;
-  }
-  if (s.maxDepth != maxDepth_) {
-    renderer_->setMaxDepth(maxDepth_);
-    restarted = true;
-  }
+  // Settings first, at the current resolution (chosen below); a new shader variant is warmed up.
+  RenderSettings next = wanted_;
+  next.width = renderer_->settings().width;
+  next.height = renderer_->settings().height;
+  SettingsChange change = renderer_->apply(next);
+  if (change.shader) warmUp();
+  bool restarted = change.restart;
   if (controller_->revision() != appliedRevision_) {
     renderer_->setCamera(controller_->camera());
     appliedRevision_ = controller_->revision();
@@ -307,11 +290,7 @@ void Viewer::syncRenderer() {
     int scale = static_cast<int>(std::clamp(std::ceil(std::sqrt(costMs_ * fullW_ * fullH_ / (0.5 * config_.budgetMs))), 2.0, 16.0));
     if (!previewing_ || (restarted && std::abs(scale - previewScale_) >= 2)) previewScale_ = scale;
     int pw = std::max(1, fullW_ / previewScale_), ph = std::max(1, fullH_ / previewScale_);
-    if (s.width != pw || s.height != ph) {
-      renderer_->resize(pw, ph);
-      displayFbStale_ = true;
-      restarted = true;
-    }
+    if (resizeRenderer(pw, ph)) restarted = true;
     previewing_ = true;
   } else {
     if (previewing_) {
@@ -319,11 +298,7 @@ void Viewer::syncRenderer() {
       if (leaving) copyPreview();
       previewing_ = false;
     }
-    if (s.width != fullW_ || s.height != fullH_) {
-      renderer_->resize(fullW_, fullH_);
-      displayFbStale_ = true;
-      restarted = true;
-    }
+    if (resizeRenderer(fullW_, fullH_)) restarted = true;
   }
   if (restarted) {
     bandY_ = 0;
@@ -331,6 +306,15 @@ void Viewer::syncRenderer() {
     showPreviewCopy_ = leaving;
     redraw_ = true;
   }
+}
+
+bool Viewer::resizeRenderer(int width, int height) {
+  RenderSettings r = renderer_->settings();
+  r.width = width;
+  r.height = height;
+  if (!renderer_->apply(r).resize) return false;
+  displayFbStale_ = true;
+  return true;
 }
 
 void Viewer::copyPreview() {
@@ -461,12 +445,12 @@ void Viewer::updateTitle(bool force) {
   lastTitle_ = t;
   std::string title = "caustica view - " + sceneName_ + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
                       format("%.3g samples/s", samplesPerSecond_) + " | " + format("%.1f ms/frame", frameMs_) + " | " +
-                      integratorName(integrator_) +
-                      (integrator_ == Integrator::Mis && !renderer_->gpuScene().casters.empty()
-                           ? (casterProbability_ > 0.0f ? " + casters" : " no casters")
+                      integratorName(wanted_.integrator) +
+                      (wanted_.integrator == Integrator::Mis && !renderer_->gpuScene().casters.empty()
+                           ? (wanted_.casterProbability > 0.0f ? " + casters" : " no casters")
                            : "") +
-                      " | " + dispersionModeName(dispersion_) + " | depth " +
-                      std::to_string(maxDepth_) + " | " + format("exposure %+.1f", config_.tone.exposureStops) +
+                      " | " + dispersionModeName(wanted_.dispersion) + " | depth " +
+                      std::to_string(wanted_.maxDepth) + " | " + format("exposure %+.1f", config_.tone.exposureStops) +
                       " | non-finite " + std::to_string(renderer_->stats().nonFinite);
   if (previewing_) title += " | preview 1/" + std::to_string(previewScale_);
   if (fly_) title += " | fly";

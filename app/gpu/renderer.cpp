@@ -11,67 +11,6 @@
 
 namespace caustica {
 
-Integrator parseIntegrator(const std::string& name) {
-  if (name == "naive") return Integrator::Naive;
-  if (name == "mis") return Integrator::Mis;
-  throw Error("unknown integrator '" + name + "' (expected naive or mis)");
-}
-
-DispersionMode parseDispersionMode(const std::string& name) {
-  if (name == "rgb") return DispersionMode::Rgb;
-  if (name == "spectral") return DispersionMode::Spectral;
-  throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
-}
-
-const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
-const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
-
-GlLimits queryGlLimits() {
-  GlLimits l;
-  GLint64 block = 0;
-  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
-  l.maxStorageBlockSize = block;
-  // CAUSTICA_MAX_SSBO_BYTES lowers the limit, to see how a scene fares on a GPU that offers only the
-  // 16 MiB the specification guarantees (used by the tests).
-  if (const char* env = std::getenv("CAUSTICA_MAX_SSBO_BYTES")) {
-    long long cap = std::atoll(env);
-    if (cap > 0 && cap < l.maxStorageBlockSize) l.maxStorageBlockSize = cap;
-  }
-  glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &l.maxComputeStorageBlocks);
-  glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &l.maxWorkGroupInvocations);
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.maxTextureSize);
-  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &l.maxWorkGroupCount[0]);
-  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &l.maxWorkGroupCount[1]);
-  return l;
-}
-
-namespace {
-
-std::string mib(double bytes) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
-  return buf;
-}
-
-void checkImageSize(const GlLimits& l, int w, int h) {
-  if (w < 1 || h < 1) throw Error("image size must be at least 1x1");
-  if (w > l.maxTextureSize || h > l.maxTextureSize)
-    throw Error("image size " + std::to_string(w) + "x" + std::to_string(h) + " exceeds this GPU's texture limit of " +
-                std::to_string(l.maxTextureSize));
-  int gx = (w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X, gy = (h + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y;
-  if (gx > l.maxWorkGroupCount[0] || gy > l.maxWorkGroupCount[1]) throw Error("image too large for one compute dispatch");
-}
-
-void checkCasterProbability(float p) {
-  if (!(p >= 0.0f && p <= kMaxCasterProbability)) {
-    std::ostringstream m;
-    m << "caster probability must be between 0 and " << kMaxCasterProbability;
-    throw Error(m.str());
-  }
-}
-
-}  // namespace
-
 Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
     : library_(library), settings_(settings), camera_(camera) {
   limits_ = queryGlLimits();
@@ -80,27 +19,20 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
                 " storage buffers per compute shader; caustica needs " + std::to_string(CAUSTICA_SSBO_COUNT));
   if (limits_.maxWorkGroupInvocations < CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y)
     throw Error("this GPU's compute work groups are too small");
+  settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
-  if (settings_.maxDepth < 1 || settings_.maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
-  checkCasterProbability(settings_.casterProbability);
 
   auto t0 = std::chrono::steady_clock::now();
   bvh_ = buildBvh(scene.triangles);
   bvhSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   gpuScene_ = packScene(scene, bvh_);
 
-  auto sized = [&](const char* what, size_t bytes) {
-    if (static_cast<std::int64_t>(bytes) > limits_.maxStorageBlockSize)
-      throw Error(scene.path + ": " + what + " need " + mib(static_cast<double>(bytes)) +
-                  " but this GPU allows " + mib(static_cast<double>(limits_.maxStorageBlockSize)) +
-                  " per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE)");
-  };
   const GpuScene& g = gpuScene_;
-  sized("BVH nodes", g.nodes.size() * sizeof(gpu::BvhNode));
-  sized("triangles", g.triShade.size() * sizeof(gpu::TriShade));
-  sized("materials", g.materials.size() * sizeof(gpu::Material));
-  sized("emitters", g.emitters.size() * sizeof(gpu::Emitter));
-  sized("textures", g.texels.size() * 4);
+  checkStorageSize(limits_, scene.path, "BVH nodes", g.nodes.size() * sizeof(gpu::BvhNode));
+  checkStorageSize(limits_, scene.path, "triangles", g.triShade.size() * sizeof(gpu::TriShade));
+  checkStorageSize(limits_, scene.path, "materials", g.materials.size() * sizeof(gpu::Material));
+  checkStorageSize(limits_, scene.path, "emitters", g.emitters.size() * sizeof(gpu::Emitter));
+  checkStorageSize(limits_, scene.path, "textures", g.texels.size() * 4);
 
   buffers_.resize(CAUSTICA_SSBO_COUNT);
   buffers_[CAUSTICA_BINDING_NODES] = GlBuffer::fromVector(g.nodes);
@@ -114,7 +46,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
   uploadCasters();
-  resize(settings_.width, settings_.height);
+  allocateImages();
   program();  // compile now, so shader errors surface before rendering starts
 }
 
@@ -144,28 +76,24 @@ void Renderer::setCamera(const Camera& camera) {
   camera_ = camera;
   reset();
 }
-void Renderer::setIntegrator(Integrator integrator) {
-  settings_.integrator = integrator;
-  program();
-  reset();
-}
-void Renderer::setDispersionMode(DispersionMode mode) {
-  settings_.dispersion = mode;
-  program();
-  reset();
-}
-void Renderer::setMaxDepth(int maxDepth) {
-  if (maxDepth < 1 || maxDepth > 1024) throw Error("max depth must be between 1 and 1024");
-  settings_.maxDepth = maxDepth;
-  reset();
-}
 
-void Renderer::setCasterProbability(float p) {
-  checkCasterProbability(p);
-  settings_.casterProbability = p;
-  uploadCasters();
-  program();
-  reset();
+SettingsChange Renderer::apply(const RenderSettings& settings) {
+  settings.validate();
+  SettingsChange change = compareSettings(settings_, settings);
+  if (!change.restart) return change;
+  if (change.resize) checkImageSize(limits_, settings.width, settings.height);
+  const RenderSettings previous = settings_;
+  settings_ = settings;
+  try {
+    if (change.shader) program();  // compile now: errors surface here, and callers may warm it up
+  } catch (...) {
+    settings_ = previous;
+    throw;
+  }
+  if (change.casters) uploadCasters();
+  if (change.resize) allocateImages();
+  else reset();
+  return change;
 }
 
 void Renderer::uploadCasters() {
@@ -180,12 +108,9 @@ void Renderer::uploadCasters() {
   casterUbo_.update(0, sizeof cp, &cp);
 }
 
-void Renderer::resize(int width, int height) {
-  checkImageSize(limits_, width, height);
-  settings_.width = width;
-  settings_.height = height;
-  accum_ = GlTexture::create2D(width, height, GL_RGBA32F);
-  comp_ = GlTexture::create2D(width, height, GL_RGBA32F);
+void Renderer::allocateImages() {
+  accum_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
+  comp_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   display_ = GlTexture();
   reset();
 }

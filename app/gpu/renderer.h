@@ -8,34 +8,16 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
 #include "accel/gpu_scene.h"
 #include "image/image_io.h"
 #include "scene/scene.h"
+#include "gpu/render_settings.h"
 #include "gpu/shader_library.h"
 #include "image/tonemap.h"
 
 namespace caustica {
-
-enum class Integrator { Naive, Mis };
-enum class DispersionMode { Rgb, Spectral };
-Integrator parseIntegrator(const std::string& name);          // "naive" | "mis"
-DispersionMode parseDispersionMode(const std::string& name);  // "rgb" | "spectral"
-const char* integratorName(Integrator i);
-const char* dispersionModeName(DispersionMode d);
-
-struct RenderSettings {
-  int width = 512, height = 512;  // pixels
-  std::uint32_t seed = 1;
-  int maxDepth = 32;              // path segments
-  Integrator integrator = Integrator::Mis;
-  DispersionMode dispersion = DispersionMode::Rgb;
-  // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
-  // instead of cosine sampling; 0 turns it off. At most kMaxCasterProbability, so every direction
-  // keeps a non-zero pdf.
-  float casterProbability = 0.5f;
-};
-constexpr float kMaxCasterProbability = 0.9f;
 
 // Totals over everything rendered since the last reset.
 struct RenderStats {
@@ -43,27 +25,17 @@ struct RenderStats {
   std::uint64_t rays() const { return primaryRays + secondaryRays + shadowRays; }
 };
 
-// Limits of the current GL implementation that matter to caustica.
-struct GlLimits {
-  std::int64_t maxStorageBlockSize = 0;  // bytes per SSBO
-  int maxComputeStorageBlocks = 0;
-  int maxWorkGroupInvocations = 0;
-  int maxTextureSize = 0;
-  int maxWorkGroupCount[2] = {0, 0};
-};
-GlLimits queryGlLimits();
-
 class Renderer {
  public:
   // Needs a current GL 4.3 context. Throws Error if the scene exceeds the GL limits.
   Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings);
 
   void setCamera(const Camera& camera);          // restarts accumulation
-  void setIntegrator(Integrator integrator);     // restarts accumulation
-  void setDispersionMode(DispersionMode mode);   // restarts accumulation
-  void setMaxDepth(int maxDepth);                // restarts accumulation
-  void setCasterProbability(float p);            // restarts accumulation
-  void resize(int width, int height);            // restarts accumulation
+  // The one place that decides what a settings change needs: new images, another shader variant,
+  // new caster parameters; any change restarts accumulation. Throws Error (and changes nothing) if
+  // `settings` is invalid or too large for this GPU. Returns what it did, so a caller can warm a
+  // new shader variant up.
+  SettingsChange apply(const RenderSettings& settings);
   void reset();
 
   // Adds `spp` samples per pixel to rows [y0, y1). Cover every row, then call endPass(spp) once.
@@ -85,6 +57,7 @@ class Renderer {
 
  private:
   const GlProgram& program();
+  void allocateImages();
   void readCounters();
   void uploadCasters();
 

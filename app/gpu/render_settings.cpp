@@ -1,0 +1,53 @@
+// render_settings.cpp — parsing, validation and comparison of RenderSettings.
+#include "gpu/render_settings.h"
+
+#include <sstream>
+
+#include "util/error.h"
+
+namespace caustica {
+
+Integrator parseIntegrator(const std::string& name) {
+  if (name == "naive") return Integrator::Naive;
+  if (name == "mis") return Integrator::Mis;
+  throw Error("unknown integrator '" + name + "' (expected naive or mis)");
+}
+
+DispersionMode parseDispersionMode(const std::string& name) {
+  if (name == "rgb") return DispersionMode::Rgb;
+  if (name == "spectral") return DispersionMode::Spectral;
+  throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
+}
+
+const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
+const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
+
+void RenderSettings::validate() const {
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+    throw Error("image size " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1 to " +
+                std::to_string(kMaxImageSide) + " pixels per side");
+  if (maxDepth < kMinMaxDepth || maxDepth > kMaxMaxDepth)
+    throw Error("max depth must be between " + std::to_string(kMinMaxDepth) + " and " + std::to_string(kMaxMaxDepth));
+  if (!(casterProbability >= 0.0f && casterProbability <= kMaxCasterProbability)) {
+    std::ostringstream m;
+    m << "caster probability must be between 0 and " << kMaxCasterProbability;
+    throw Error(m.str());
+  }
+}
+
+bool RenderSettings::operator==(const RenderSettings& o) const {
+  return width == o.width && height == o.height && seed == o.seed && maxDepth == o.maxDepth &&
+         integrator == o.integrator && dispersion == o.dispersion && casterProbability == o.casterProbability;
+}
+
+SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to) {
+  SettingsChange c;
+  c.restart = from != to;
+  c.resize = from.width != to.width || from.height != to.height;
+  c.shader = from.integrator != to.integrator || from.dispersion != to.dispersion ||
+             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f);
+  c.casters = from.casterProbability != to.casterProbability;
+  return c;
+}
+
+}  // namespace caustica

@@ -1,0 +1,47 @@
+// render_settings.h — the one value that says how to render (size, seed, depth, estimator, dispersion,
+// caster aiming): parsed once by every command, validated here, applied by Renderer::apply. No GL.
+#pragma once
+#include <cstdint>
+#include <string>
+
+namespace caustica {
+
+enum class Integrator { Naive, Mis };
+enum class DispersionMode { Rgb, Spectral };
+Integrator parseIntegrator(const std::string& name);          // "naive" | "mis"; throws Error otherwise
+DispersionMode parseDispersionMode(const std::string& name);  // "rgb" | "spectral"; throws Error otherwise
+const char* integratorName(Integrator i);
+const char* dispersionModeName(DispersionMode d);
+
+constexpr int kMinMaxDepth = 1;                   // bounds of RenderSettings::maxDepth (path segments)
+constexpr int kMaxMaxDepth = 1024;
+constexpr float kMaxCasterProbability = 0.9f;     // every direction keeps a non-zero cosine pdf
+constexpr int kMaxImageSide = 16384;              // pixels; the GPU's texture limit may be lower
+
+struct RenderSettings {
+  int width = 512, height = 512;  // pixels
+  std::uint32_t seed = 1;
+  int maxDepth = 32;              // path segments, kMinMaxDepth..kMaxMaxDepth
+  Integrator integrator = Integrator::Mis;
+  DispersionMode dispersion = DispersionMode::Rgb;
+  // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
+  // instead of cosine sampling; 0 turns it off; at most kMaxCasterProbability.
+  float casterProbability = 0.5f;
+
+  // Throws Error naming the first setting out of range.
+  void validate() const;
+  bool operator==(const RenderSettings& o) const;
+  bool operator!=(const RenderSettings& o) const { return !(*this == o); }
+};
+
+// What changing the settings from `from` to `to` asks of a renderer. Every change restarts
+// accumulation; some also need new images, another shader variant or new caster parameters.
+struct SettingsChange {
+  bool restart = false;  // anything differs: the accumulated samples no longer belong to the image
+  bool resize = false;   // width or height: new accumulation images
+  bool shader = false;   // integrator, dispersion mode or caster aiming on/off: maybe another variant
+  bool casters = false;  // caster probability: the caster UBO
+};
+SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to);
+
+}  // namespace caustica
