@@ -4,6 +4,7 @@
 #include "lib/bindings.glsl"
 #include "lib/rng.glsl"
 #include "lib/sampling.glsl"
+#include "lib/spawn.glsl"
 #include "lib/intersect.glsl"
 #include "lib/traverse.glsl"
 #include "lib/camera.glsl"
@@ -49,6 +50,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
     TriShade s = triShade[hit.tri];
     float b0 = 1.0 - hit.u - hit.v;
     vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
+    vec3 pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);  // spawn.glsl
     vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
     float crLen = length(cr);
     if (!(crLen > 0.0)) break;
@@ -78,7 +80,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
     vec4 base = materialBaseColor(m, uv);
 #ifdef CAUSTICA_OPACITY
     if (base.a < 1.0 && rand01(rng) >= base.a) {  // pass straight through (a delta event)
-      org = offsetRayOrigin(p, -ng);
+      org = offsetRayOrigin(p, pError, -ng);
       prevDelta = true;
       continue;
     }
@@ -114,8 +116,13 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
           cosLight = abs(cosLight);
           float pdfLight = ls.pdfArea * dist2 / cosLight;
           ++gShadowRays;
-          // Stop just short of the light so its own triangle (and coplanar neighbours) do not occlude.
-          if (!traceOccluded(offsetRayOrigin(p, ng), wl, dist * (1.0 - 1.0e-4))) {
+          // Both ends leave their surfaces past their error bounds (spawn.glsl), and the ray stops just
+          // short of the light's offset point, so neither surface can occlude it at any scale.
+          vec3 from = offsetRayOrigin(p, pError, ng);
+          vec3 to = offsetRayOrigin(ls.p, ls.pError, dot(ls.n, wl) < 0.0 ? ls.n : -ls.n);  // towards p
+          vec3 seg = to - from;
+          float segLen = length(seg);
+          if (segLen > 0.0 && !traceOccluded(from, seg / segLen, segLen * (1.0 - 1.0e-4))) {
 #ifdef CAUSTICA_CASTERS
             float pdfBsdf = diffuseDirectionPdf(ns, wl);
 #else
@@ -202,7 +209,7 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
       beta /= q;
     }
     dir = newDir;
-    org = offsetRayOrigin(p, dot(dir, ng) > 0.0 ? ng : -ng);
+    org = offsetRayOrigin(p, pError, dot(dir, ng) > 0.0 ? ng : -ng);
   }
   return radiance;
 }

@@ -1,4 +1,5 @@
 #include "lib/bindings.glsl"
+#include "lib/spawn.glsl"
 #include "lib/intersect.glsl"
 #include "lib/traverse.glsl"
 // trace_test.comp — GPU test entry: traces a batch of rays with traceClosest and traceOccluded so a

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "accel/spawn.h"
 #include "util/error.h"
 
 namespace caustica {
@@ -374,10 +375,23 @@ bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
   const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
   if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return false;
 
-  const float tScaled = e0 * (sz * a.z) + e1 * (sz * b.z) + e2 * (sz * c.z);
+  const float az = sz * a.z, bz = sz * b.z, cz = sz * c.z;
+  const float tScaled = e0 * az + e1 * bz + e2 * cz;
   const float invDet = 1.0f / det;
   const float tt = tScaled * invDet;
   if (!(tt > 0.0f && tt < tmax)) return false;  // also rejects NaN
+  // t must be conservatively positive: beyond the bound of its own rounding error (pbrt-v4), so a
+  // ray spawned past a hit point's error box never re-hits the surface it leaves.
+  const float maxZt = std::max(std::fabs(az), std::max(std::fabs(bz), std::fabs(cz)));
+  const float maxXt = std::max(std::fabs(ax), std::max(std::fabs(bx), std::fabs(cx)));
+  const float maxYt = std::max(std::fabs(ay), std::max(std::fabs(by), std::fabs(cy)));
+  const float deltaZ = gammaBound(3) * maxZt;
+  const float deltaX = gammaBound(5) * (maxXt + maxZt);
+  const float deltaY = gammaBound(5) * (maxYt + maxZt);
+  const float deltaE = 2.0f * (gammaBound(2) * maxXt * maxYt + deltaY * maxXt + deltaX * maxYt);
+  const float maxE = std::max(std::fabs(e0), std::max(std::fabs(e1), std::fabs(e2)));
+  const float deltaT = 3.0f * (gammaBound(3) * maxE * maxZt + deltaE * maxZt + deltaZ * maxE) * std::fabs(invDet);
+  if (tt <= deltaT) return false;
   t = tt;
   u = e1 * invDet;
   v = e2 * invDet;

@@ -85,21 +85,6 @@ float sampleDielectric(const glm::vec3& d, const glm::vec3& n, float eta, float 
   return 1.0f / (eta * eta);
 }
 
-glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n) {
-  constexpr float kOrigin = 1.0f / 32.0f, kFloatScale = 1.0f / 65536.0f, kIntScale = 256.0f;
-  glm::vec3 out;
-  for (int i = 0; i < 3; ++i) {
-    int of = static_cast<int>(kIntScale * n[i]);
-    std::int32_t bits;
-    std::memcpy(&bits, &p[i], 4);
-    bits += p[i] < 0.0f ? -of : of;
-    float pi;
-    std::memcpy(&pi, &bits, 4);
-    out[i] = std::fabs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : pi;
-  }
-  return out;
-}
-
 float cauchyIor(float iorD, float abbe, float lambdaNm) {
   if (abbe <= 0.0f) return iorD;
   const float lF = 486.1f, lC = 656.3f, lD = 587.6f;

@@ -24,7 +24,6 @@ float fresnelDielectric(float cosI, float eta);        // eta = n_t / n_i
 bool refractDir(const glm::vec3& d, const glm::vec3& n, float eta, glm::vec3& t);  // eta = n_i / n_t
 // Returns the throughput factor; see materials.glsl.
 float sampleDielectric(const glm::vec3& d, const glm::vec3& n, float eta, float u, glm::vec3& wi, bool& transmitted);
-glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n);
 float cauchyIor(float iorD, float abbe, float lambdaNm);
 glm::vec3 channelSensitivity(float lambdaNm);
 

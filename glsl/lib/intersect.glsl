@@ -1,5 +1,6 @@
 // intersect.glsl — watertight ray–triangle test and ray–box slab test (world space; t in units of |dir|).
-// Twins of intersectTriangle() and intersectAabb() in app/core/bvh.cpp; keep the two in step.
+// Twins of intersectTriangle() and intersectAabb() in app/accel/bvh.cpp; keep the two in step.
+// Needs gammaBound() from spawn.glsl.
 
 // Cyclic permutation that moves axis kz to z (keeps handedness; both faces are accepted anyway).
 vec3 permuteToKz(vec3 a, int kz) {
@@ -45,10 +46,23 @@ bool intersectTriangle(vec3 org, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float tmax
   // Zero-area triangles can pass the test above once their vertices are rounded in ray space.
   if (all(equal(cross(p1 - p0, p2 - p0), vec3(0.0)))) return false;
 
-  float tScaled = e0 * (sz * a.z) + e1 * (sz * b.z) + e2 * (sz * c.z);
+  float az = sz * a.z, bz = sz * b.z, cz = sz * c.z;
+  float tScaled = e0 * az + e1 * bz + e2 * cz;
   float invDet = 1.0 / det;
   float tt = tScaled * invDet;
   if (!(tt > 0.0 && tt < tmax)) return false;  // also rejects NaN
+  // t must be conservatively positive: beyond the bound of its own rounding error (pbrt-v4), so a
+  // ray spawned past a hit point's error box never re-hits the surface it leaves.
+  float maxZt = max(abs(az), max(abs(bz), abs(cz)));
+  float maxXt = max(abs(ax), max(abs(bx), abs(cx)));
+  float maxYt = max(abs(ay), max(abs(by), abs(cy)));
+  float deltaZ = gammaBound(3) * maxZt;
+  float deltaX = gammaBound(5) * (maxXt + maxZt);
+  float deltaY = gammaBound(5) * (maxYt + maxZt);
+  float deltaE = 2.0 * (gammaBound(2) * maxXt * maxYt + deltaY * maxXt + deltaX * maxYt);
+  float maxE = max(abs(e0), max(abs(e1), abs(e2)));
+  float deltaT = 3.0 * (gammaBound(3) * maxE * maxZt + deltaE * maxZt + deltaZ * maxE) * abs(invDet);
+  if (tt <= deltaT) return false;
   t = tt;
   u = e1 * invDet;
   v = e2 * invDet;

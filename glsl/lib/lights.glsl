@@ -3,6 +3,7 @@
 
 struct LightSample {
   vec3 p;        // world-space point on the emitter
+  vec3 pError;   // bound on p's rounding error, per axis (spawn.glsl)
   vec3 n;        // unit geometric normal of the emitter's front face
   vec3 le;       // emitted radiance at p (towards the front; both ways if double-sided)
   float pdfArea; // probability density per unit area (selection and position)
@@ -25,6 +26,7 @@ bool sampleLight(float uSlot, float uAlias, vec2 uTri, out LightSample ls) {
   TriGeom g = triGeom[tri];
   vec2 b = sampleTriangleUniform(uTri);
   ls.p = (1.0 - b.x - b.y) * g.v0.xyz + b.x * g.v1.xyz + b.y * g.v2.xyz;
+  ls.pError = hitPointError(1.0 - b.x - b.y, b.x, b.y, g.v0.xyz, g.v1.xyz, g.v2.xyz);
   vec3 c = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
   float len = length(c);
   if (!(len > 0.0)) return false;

@@ -62,18 +62,3 @@ bool refractDir(vec3 d, vec3 n, float eta, out vec3 t) {
   t = normalize(eta * d + (eta * cosI - cosT) * n);
   return true;
 }
-
-// Moves a hit point off its surface along the geometric normal n (unit, on the side the new ray
-// leaves): a few ULPs far from the origin, a fixed tiny step near it (Waechter & Binder 2019).
-vec3 offsetRayOrigin(vec3 p, vec3 n) {
-  const float kOrigin = 1.0 / 32.0;
-  const float kFloatScale = 1.0 / 65536.0;
-  const float kIntScale = 256.0;
-  ivec3 of = ivec3(kIntScale * n);
-  vec3 pi = vec3(intBitsToFloat(floatBitsToInt(p.x) + (p.x < 0.0 ? -of.x : of.x)),
-                 intBitsToFloat(floatBitsToInt(p.y) + (p.y < 0.0 ? -of.y : of.y)),
-                 intBitsToFloat(floatBitsToInt(p.z) + (p.z < 0.0 ? -of.z : of.z)));
-  return vec3(abs(p.x) < kOrigin ? p.x + kFloatScale * n.x : pi.x,
-              abs(p.y) < kOrigin ? p.y + kFloatScale * n.y : pi.y,
-              abs(p.z) < kOrigin ? p.z + kFloatScale * n.z : pi.z);
-}

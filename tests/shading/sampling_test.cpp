@@ -193,27 +193,6 @@ TEST_CASE("dielectric sampling: reflects with probability F, refracts by Snell, 
   }
 }
 
-TEST_CASE("offset ray origins land on the intended side of the surface") {
-  std::mt19937 g(11);
-  std::uniform_real_distribution<float> u(-1, 1);
-  std::uniform_real_distribution<float> e(-8, 8);
-  int wrong = 0;
-  for (int k = 0; k < 100000; ++k) {
-    float scale = std::pow(10.0f, e(g) / 2);  // positions from 1e-4 to 1e4
-    glm::vec3 p0 = glm::vec3(u(g), u(g), u(g)) * scale, p1 = p0 + glm::vec3(u(g), u(g), u(g)) * scale,
-              p2 = p0 + glm::vec3(u(g), u(g), u(g)) * scale;
-    glm::dvec3 nd = glm::cross(glm::dvec3(p1) - glm::dvec3(p0), glm::dvec3(p2) - glm::dvec3(p0));
-    if (glm::length(nd) < 1e-12 * scale * scale) continue;
-    nd = glm::normalize(nd);
-    float b1 = (u(g) + 1) / 2, b2 = (u(g) + 1) / 2 * (1 - b1);
-    glm::vec3 p = (1 - b1 - b2) * p0 + b1 * p1 + b2 * p2;  // computed in float, may be off the plane
-    glm::vec3 o = offsetRayOrigin(p, glm::vec3(nd));
-    double side = glm::dot(glm::dvec3(o) - glm::dvec3(p0), nd);
-    if (!(side > 0.0)) ++wrong;
-  }
-  CHECK(wrong == 0);
-}
-
 TEST_CASE("Cauchy fit reproduces the index at the d line and the Abbe number") {
   for (float ior : {1.33f, 1.5f, 1.9f})
     for (float abbe : {20.0f, 40.0f, 64.0f}) {
