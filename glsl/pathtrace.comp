@@ -25,7 +25,7 @@ uint gSecondaryRays = 0u;
 uint gShadowRays = 0u;
 
 // One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
-vec3 tracePath(uvec2 pixel, inout uint rng) {
+vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   vec3 org = frame.camPos.xyz;
   vec3 dir = eyeRayDirection(pixel, rand2(rng));
   vec3 beta = vec3(1.0);   // path throughput
@@ -230,7 +230,7 @@ void main() {
   // (see Renderer::renderRows); the host dispatches once per sample.
   uint primary = 0u, bad = 0u;
   if (valid) {
-    uint rng = rngSeed(pixel.y * frame.frame.x + pixel.x, frame.frame.z, frame.frame.w);
+    uvec4 rng = rngSeed(pixel.y * frame.frame.x + pixel.x, frame.frame.z, frame.frame.w);
     vec3 l = tracePath(pixel, rng);
     primary = 1u;
     bool finite = !(any(isnan(l)) || any(isinf(l)));

@@ -7,23 +7,6 @@
 
 namespace caustica {
 
-std::uint32_t pcgHash(std::uint32_t v) {
-  std::uint32_t state = v * 747796405u + 2891336453u;
-  std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  return (word >> 22u) ^ word;
-}
-
-std::uint32_t rngSeed(std::uint32_t pixel, std::uint32_t sampleIndex, std::uint32_t seed) {
-  return pcgHash(pixel ^ pcgHash(sampleIndex ^ pcgHash(seed)));
-}
-
-float rand01(std::uint32_t& state) {
-  state = state * 747796405u + 2891336453u;
-  std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  word = (word >> 22u) ^ word;
-  return static_cast<float>(word >> 8u) * (1.0f / 16777216.0f);
-}
-
 float luminance(const glm::vec3& c) { return glm::dot(c, glm::vec3(0.2126f, 0.7152f, 0.0722f)); }
 
 void orthonormalBasis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {

@@ -1,19 +1,17 @@
 // sampling.h — C++ twins of the GLSL sampling routines in glsl/lib/sampling.glsl, materials.glsl,
-// spectral.glsl and rng.glsl (same names, same arithmetic), so tests can check what the shader does.
+// spectral.glsl and casters.glsl (rng.glsl: shading/rng.h) (same names, same arithmetic), so tests can check what the shader does.
 #pragma once
 #include <cstdint>
 
 #include <glm/glm.hpp>
 
+#include "shading/rng.h"
 #include "shared/gpu_layout.h"
 #include "util/math_constants.h"
 
 namespace caustica {
 
 
-std::uint32_t pcgHash(std::uint32_t v);
-std::uint32_t rngSeed(std::uint32_t pixel, std::uint32_t sampleIndex, std::uint32_t seed);
-float rand01(std::uint32_t& state);
 
 float luminance(const glm::vec3& c);
 void orthonormalBasis(const glm::vec3& n, glm::vec3& t, glm::vec3& b);

@@ -43,7 +43,7 @@ TEST_CASE("alias table picks each item with probability proportional to its weig
     CHECK(table[i].pdfSelect == doctest::Approx(w[i] / total).epsilon(1e-6));
   }
   // And sampling it the way lights.glsl does agrees (chi-square-like bound on counts).
-  std::uint32_t rng = 12345;
+  RngState rng = rngSeed(12345, 0, 0);
   std::vector<int> counts(w.size(), 0);
   const int n = 200000;
   for (int k = 0; k < n; ++k) {
