@@ -1,5 +1,5 @@
 // scene.h — the renderer's in-memory scene: world-space triangles, materials after the glTF
-// material contract (docs/materials.md), textures and cameras. Loaded from glTF 2.0 by scene_gltf.cpp.
+// material contract (docs/materials.md), textures and cameras. Loaded from glTF 2.0 by gltf_loader.cpp.
 #pragma once
 #include <cstdint>
 #include <limits>

@@ -1,0 +1,153 @@
+// gltf_internal.h — what the glTF loader's files (gltf_*.cpp) share: the limits on hostile input,
+// message helpers, the JSON check, image decoding and SceneBuilder (tinygltf model -> Scene).
+// Private to app/scene; the public API is loadScene / autoCamera in scene/scene.h.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+// Third-party headers of the loader (JSON check, image decoding, tinygltf), their warnings silenced.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wshadow"
+#include <nlohmann/json.hpp>
+#include <stb_image.h>
+#include <tiny_gltf.h>
+#pragma GCC diagnostic pop
+
+#include "util/error.h"
+#include "scene/scene.h"
+
+namespace caustica::gltf {
+
+// ---- limits that keep hostile files from exhausting the stack or memory ------------------------
+constexpr int kMaxJsonDepth = 64;                       // nesting of JSON arrays/objects
+constexpr std::uint64_t kMaxIndex = 0x7fffffff;         // any glTF index (tinygltf stores int)
+constexpr std::uint64_t kMaxByteCount = 1ull << 53;     // byte lengths/offsets (exact in a double)
+constexpr std::uint64_t kMaxZeroElements = 1ull << 22;  // elements of an accessor without bufferView
+constexpr std::uint64_t kMaxDecoded = 1ull << 28;       // accessor elements decoded for the whole scene
+constexpr std::size_t kMaxTriangles = 1u << 24;         // triangles in a scene (GPU buffers: 112 B each)
+constexpr int kMaxTextureSide = 16384;                  // texels
+constexpr std::int64_t kMaxTexturePixels = 1ll << 26;   // texels in one texture (256 MiB as RGBA8)
+constexpr std::size_t kMaxMessage = 300;                // characters kept from a third-party message
+
+// ---- messages (gltf_loader.cpp) ------------------------------------------------------------------
+// A third-party message (tinygltf, nlohmann, stb) as one printable line: lines joined with "; ",
+// control and non-ASCII bytes replaced, and the length bounded.
+std::string oneLine(const std::string& text);
+inline std::string str(std::uint64_t v) { return std::to_string(v); }
+std::string num(double v);
+
+// ---- JSON structure check (gltf_json_check.cpp) --------------------------------------------------
+// True for the extensions caustica implements (KHR_materials_*).
+bool isSupportedExtension(const std::string& name);
+// Rejects JSON nested deeper than kMaxJsonDepth, invalid JSON and documents whose structure tinygltf
+// would not check (types, indices, byte ranges, buffer sources). baseDir: folder of external files;
+// binary: jsonText is a GLB's JSON chunk. Throws Error("PATH: ...").
+void checkJson(const std::string& path, const std::string& jsonText, const std::string& baseDir, bool binary);
+
+// ---- byte access (gltf_accessors.cpp) ------------------------------------------------------------
+// True when `count` elements of `elem` bytes, `stride` bytes apart, starting at `offset`, lie inside
+// `length` bytes. Written without products that could overflow.
+bool rangeFits(std::uint64_t offset, std::uint64_t stride, std::uint64_t count, std::uint64_t elem,
+               std::uint64_t length);
+// A little-endian 32-bit unsigned integer.
+std::uint32_t readU32(const unsigned char* p);
+
+// A component type with its normalized flag: one legal storage of an attribute.
+struct Format {
+  int componentType;
+  bool normalized;
+};
+
+// ---- image decoding (gltf_materials.cpp) ---------------------------------------------------------
+// Decodes every image to 8-bit RGBA with stb_image. A failure is recorded rather than returned, so
+// an unused broken image does not stop loading; using it is an error (SceneBuilder::texture).
+struct ImageLog {
+  std::map<int, std::string> failures;  // image index -> reason
+};
+
+// tinygltf's image-loader callback; `user` is the ImageLog.
+bool decodeImage(tinygltf::Image* image, int index, std::string*, std::string*, int, int, const unsigned char* bytes,
+                 int size, void* user);
+
+// ---- glTF model -> Scene -------------------------------------------------------------------------
+struct NodeTransform {
+  glm::dmat4 world{1.0};
+  glm::dmat3 normal{1.0};  // inverse transpose of the upper 3x3
+  bool flip = false;       // negative determinant: glTF then defines clockwise fronts
+};
+
+// Converts a loaded tinygltf model into `scene`: materials, the default scene's node tree, cameras
+// and world-space triangles. Its member functions are defined in gltf_nodes.cpp (build, the node
+// walk, meshes, cameras), gltf_materials.cpp (materials, textures) and gltf_accessors.cpp (accessors).
+class SceneBuilder {
+ public:
+  SceneBuilder(const std::string& path, const tinygltf::Model& model, const ImageLog& images, Scene& scene)
+      : path_(path), model_(model), images_(images), scene_(scene) {}
+
+  void build();
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const { throw Error(path_ + ": " + what); }
+  void warn(const std::string& what) { scene_.warnings.push_back(path_ + ": " + what); }
+
+  void skip(const std::string& what) {
+    if (firstSkip_.empty()) firstSkip_ = what;
+    warn(what);
+  }
+
+  void warnUnsupportedExtensions();
+
+  // ---- materials (gltf_materials.cpp) ----
+  double unit(double v, const std::string& what);
+  Material convertMaterial(int index);
+  int texture(const tinygltf::TextureInfo& info, const std::string& at);
+  std::uint32_t defaultMaterial(const std::string& at);
+
+  // ---- node hierarchy (gltf_nodes.cpp) ----
+  glm::dmat4 localMatrix(const tinygltf::Node& node, const std::string& at);
+  std::vector<int> checkHierarchy();
+  void traverse();
+  void addCamera(int index, const glm::dmat4& world, const tinygltf::Node& node, const std::string& at);
+
+  // ---- accessors (gltf_accessors.cpp) ----
+  struct ViewBytes {
+    const unsigned char* data = nullptr;
+    std::uint64_t length = 0;
+    std::uint64_t stride = 0;  // 0 = tightly packed
+  };
+
+  ViewBytes bufferView(int index, const std::string& at) const;
+  std::vector<double> readAccessor(int index, int type, std::initializer_list<Format> allowed, const std::string& use);
+  std::vector<double> readAttribute(const tinygltf::Primitive& prim, const char* name, int type,
+                                    std::initializer_list<Format> allowed, std::size_t vertexCount,
+                                    const std::string& at);
+
+  // ---- meshes (gltf_nodes.cpp) ----
+  void addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt);
+  void addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at);
+
+  const std::string& path_;
+  const tinygltf::Model& model_;
+  const ImageLog& images_;
+  Scene& scene_;
+  std::map<int, int> textureMap_;  // glTF texture index -> Scene::textures index (-1: ignored)
+  int defaultMaterial_ = -1;
+  std::size_t degenerate_ = 0;   // zero-area triangles dropped
+  std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable
+  std::size_t candidates_ = 0;   // triangles assembled so far, degenerate ones included
+  std::uint64_t decoded_ = 0;    // accessor elements decoded so far
+  bool warnedSkin_ = false;
+  bool warnedTargets_ = false;
+  std::string firstSkip_;  // first reason a primitive was skipped, quoted when nothing is left
+};
+
+}  // namespace caustica::gltf

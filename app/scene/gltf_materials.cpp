@@ -1,0 +1,222 @@
+// gltf_materials.cpp — glTF materials after the contract in docs/materials.md, and their textures:
+// images decoded by stb_image (tinygltf's image callback), samplers, the default material.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "scene/gltf_internal.h"
+
+namespace caustica::gltf {
+namespace {
+
+const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
+  const auto it = map.find(name);
+  return it == map.end() || !it->second.IsObject() ? nullptr : &it->second;
+}
+
+double extNumber(const tinygltf::Value* ext, const char* key, double fallback) {
+  if (!ext || !ext->Has(key) || !ext->Get(key).IsNumber()) return fallback;
+  return ext->Get(key).GetNumberAsDouble();
+}
+
+bool extHas(const tinygltf::Value* ext, const char* key) { return ext && ext->Has(key); }
+
+void wrapMode(int mode, bool& repeat, bool& mirror) {
+  repeat = mode != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  mirror = mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT;
+}
+
+}  // namespace
+
+bool decodeImage(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+                 const unsigned char* bytes, int size, void* user) {
+  auto* log = static_cast<ImageLog*>(user);
+  int w = 0, h = 0, channels = 0;
+  if (!bytes || size <= 0 || !stbi_info_from_memory(bytes, size, &w, &h, &channels)) {
+    const char* reason = stbi_failure_reason();
+    log->failures[index] = std::string("not a decodable PNG/JPEG image (") + (reason ? reason : "unknown format") + ")";
+    return true;
+  }
+  if (w < 1 || h < 1 || w > kMaxTextureSide || h > kMaxTextureSide ||
+      std::int64_t(w) * std::int64_t(h) > kMaxTexturePixels) {
+    log->failures[index] = "its size " + str(std::uint64_t(std::max(w, 0))) + "x" + str(std::uint64_t(std::max(h, 0))) +
+                           " is out of range (at most " + str(kMaxTextureSide) + " per side)";
+    return true;
+  }
+  unsigned char* pixels = stbi_load_from_memory(bytes, size, &w, &h, &channels, 4);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    log->failures[index] = std::string("it could not be decoded (") + (reason ? reason : "unknown error") + ")";
+    return true;
+  }
+  image->width = w;
+  image->height = h;
+  image->component = 4;
+  image->bits = 8;
+  image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  image->image.assign(pixels, pixels + std::size_t(w) * std::size_t(h) * 4);
+  stbi_image_free(pixels);
+  return true;
+}
+
+double SceneBuilder::unit(double v, const std::string& what) {
+  if (v < 0.0 || v > 1.0) {
+    warn(what + " = " + num(v) + " is outside [0, 1]; clamped");
+    return std::clamp(v, 0.0, 1.0);
+  }
+  return v;
+}
+
+Material SceneBuilder::convertMaterial(int index) {
+  const tinygltf::Material& m = model_.materials[std::size_t(index)];
+  const std::string at = "materials[" + str(std::uint64_t(index)) + "]";
+  Material out;
+  out.name = m.name.empty() ? "material " + str(std::uint64_t(index)) : m.name;
+  const auto& pbr = m.pbrMetallicRoughness;
+
+  glm::dvec4 base(1.0);
+  for (std::size_t c = 0; c < 4 && c < pbr.baseColorFactor.size(); ++c)
+    base[int(c)] = unit(pbr.baseColorFactor[c], at + ".baseColorFactor[" + str(c) + "]");
+  out.metallic = float(unit(pbr.metallicFactor, at + ".metallicFactor"));
+  out.roughness = float(unit(pbr.roughnessFactor, at + ".roughnessFactor"));
+  out.baseColorTexture = texture(pbr.baseColorTexture, at + ".baseColorTexture");
+
+  // Opacity: OPAQUE ignores alpha, MASK thresholds the factor, BLEND keeps it. Texture alpha is
+  // not used (docs/materials.md).
+  if (m.alphaMode == "OPAQUE" || m.alphaMode.empty()) {
+    base.a = 1.0;
+  } else if (m.alphaMode == "MASK") {
+    base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
+  } else if (m.alphaMode != "BLEND") {
+    fail(at + ".alphaMode is \"" + oneLine(m.alphaMode) + "\"; it must be OPAQUE, BLEND or MASK");
+  }
+  out.baseColor = glm::vec4(base);
+
+  // Emission: emissiveFactor x KHR_materials_emissive_strength = radiance (linear).
+  glm::dvec3 emissive(0.0);
+  for (std::size_t c = 0; c < 3 && c < m.emissiveFactor.size(); ++c) {
+    emissive[int(c)] = m.emissiveFactor[c];
+    if (emissive[int(c)] < 0.0) {
+      warn(at + ".emissiveFactor[" + str(c) + "] is negative; clamped to 0");
+      emissive[int(c)] = 0.0;
+    }
+  }
+  double strength = extNumber(extension(m.extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0);
+  if (strength < 0.0) {
+    warn(at + ": emissiveStrength " + num(strength) + " is negative; using 0");
+    strength = 0.0;
+  }
+  out.emission = glm::vec3(emissive * strength);
+  if (!std::isfinite(out.emission.r) || !std::isfinite(out.emission.g) || !std::isfinite(out.emission.b))
+    fail(at + ": emitted radiance overflows a float");
+  out.emissiveTexture = texture(m.emissiveTexture, at + ".emissiveTexture");
+  out.doubleSided = m.doubleSided;
+
+  std::string ignored;
+  const auto ignore = [&](bool present, const char* what) {
+    if (present) ignored += (ignored.empty() ? "" : ", ") + std::string(what);
+  };
+  ignore(pbr.metallicRoughnessTexture.index >= 0, "metallicRoughnessTexture");
+  ignore(m.normalTexture.index >= 0, "normalTexture");
+  ignore(m.occlusionTexture.index >= 0, "occlusionTexture");
+
+  if (const tinygltf::Value* t = extension(m.extensions, "KHR_materials_transmission")) {
+    out.transmission = float(unit(extNumber(t, "transmissionFactor", 0.0), at + ".transmissionFactor"));
+    ignore(extHas(t, "transmissionTexture"), "transmissionTexture");
+  }
+  if (const tinygltf::Value* e = extension(m.extensions, "KHR_materials_ior")) {
+    const double ior = extNumber(e, "ior", 1.5);
+    if (ior < 1.0) warn(at + ": ior " + num(ior) + " is below 1; using 1.5");
+    else out.ior = float(ior);
+  }
+  if (const tinygltf::Value* v = extension(m.extensions, "KHR_materials_volume")) {
+    // thicknessFactor is ignored: the ray tracer follows the real geometry through the volume.
+    ignore(extHas(v, "thicknessTexture"), "thicknessTexture");
+    if (extHas(v, "attenuationColor") && v->Get("attenuationColor").ArrayLen() == 3)
+      for (int c = 0; c < 3; ++c)
+        out.attenuationColor[c] = float(unit(v->Get("attenuationColor").Get(c).GetNumberAsDouble(),
+                                             at + ".attenuationColor[" + str(std::uint64_t(c)) + "]"));
+    const double distance = extNumber(v, "attenuationDistance", std::numeric_limits<double>::infinity());
+    if (!(distance > 0.0)) warn(at + ": attenuationDistance " + num(distance) + " is not positive; no absorption");
+    else out.attenuationDistance = float(distance);
+  }
+  if (const tinygltf::Value* d = extension(m.extensions, "KHR_materials_dispersion")) {
+    const double dispersion = extNumber(d, "dispersion", 0.0);
+    if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
+    else out.dispersion = float(dispersion);
+  }
+  if (!ignored.empty()) warn(at + " '" + oneLine(out.name) + "': ignoring unsupported " + ignored);
+  if (out.roughness > 0.0f && (out.metallic > 0.0f || out.transmission > 0.0f))
+    warn(at + " '" + oneLine(out.name) + "': roughness " + num(out.roughness) +
+         " on a mirror/glass component is rendered as perfectly smooth (rough lobes are not implemented)");
+  return out;
+}
+
+int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& at) {
+  if (info.index < 0) return -1;
+  if (std::size_t(info.index) >= model_.textures.size())
+    fail(at + ".index is " + str(std::uint64_t(info.index)) + ", but the file has " + str(model_.textures.size()) +
+         " textures");
+  if (info.texCoord != 0)
+    warn(at + " uses TEXCOORD_" + str(std::uint64_t(info.texCoord)) + "; only TEXCOORD_0 is loaded and used instead");
+  if (info.extensions.count("KHR_texture_transform")) warn(at + ": KHR_texture_transform is not supported; ignored");
+  const auto cached = textureMap_.find(info.index);
+  if (cached != textureMap_.end()) return cached->second;
+
+  const tinygltf::Texture& tex = model_.textures[std::size_t(info.index)];
+  const std::string tat = "textures[" + str(std::uint64_t(info.index)) + "]";
+  int result = -1;
+  if (tex.source < 0) {
+    warn(tat + " has no PNG/JPEG source image; ignored");
+  } else {
+    if (std::size_t(tex.source) >= model_.images.size())
+      fail(tat + ".source is " + str(std::uint64_t(tex.source)) + ", but the file has " + str(model_.images.size()) +
+           " images");
+    const tinygltf::Image& img = model_.images[std::size_t(tex.source)];
+    const std::string iat = "images[" + str(std::uint64_t(tex.source)) + "]" +
+                            (img.uri.empty() ? std::string() : " '" + oneLine(img.uri) + "'");
+    if (img.image.empty()) {
+      const auto reason = images_.failures.find(tex.source);
+      fail(iat + " could not be loaded: " +
+           (reason != images_.failures.end() ? reason->second : std::string("file not found or unreadable")));
+    }
+    if (img.width < 1 || img.height < 1 || img.component != 4 || img.bits != 8 ||
+        img.image.size() != std::size_t(img.width) * std::size_t(img.height) * 4)
+      fail(iat + " has an unexpected pixel layout");
+    Texture out;
+    out.width = img.width;
+    out.height = img.height;
+    out.rgba = img.image;
+    if (tex.sampler >= 0) {
+      if (std::size_t(tex.sampler) >= model_.samplers.size())
+        fail(tat + ".sampler is " + str(std::uint64_t(tex.sampler)) + ", but the file has " +
+             str(model_.samplers.size()) + " samplers");
+      const tinygltf::Sampler& s = model_.samplers[std::size_t(tex.sampler)];
+      wrapMode(s.wrapS, out.repeatS, out.mirrorS);
+      wrapMode(s.wrapT, out.repeatT, out.mirrorT);
+      out.nearest = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+    }
+    scene_.textures.push_back(std::move(out));
+    result = int(scene_.textures.size() - 1);
+  }
+  textureMap_[info.index] = result;
+  return result;
+}
+
+std::uint32_t SceneBuilder::defaultMaterial(const std::string& at) {
+  if (defaultMaterial_ < 0) {
+    Material m;
+    m.name = "default (no material)";
+    m.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+    m.metallic = 0.0f;
+    m.roughness = 1.0f;
+    scene_.materials.push_back(m);
+    defaultMaterial_ = int(scene_.materials.size() - 1);
+    warn(at + " has no material; primitives without one use a plain diffuse grey (albedo 0.8)");
+  }
+  return std::uint32_t(defaultMaterial_);
+}
+
+}  // namespace caustica::gltf

@@ -1,0 +1,328 @@
+// gltf_nodes.cpp — the walk over the default scene's node tree: hierarchy checks, node transforms,
+// cameras, and mesh primitives assembled into world-space triangles; SceneBuilder::build drives it.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "util/math_constants.h"
+#include "scene/gltf_internal.h"
+
+namespace caustica::gltf {
+
+void SceneBuilder::build() {
+  warnUnsupportedExtensions();
+  for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
+  traverse();
+  if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
+  if (badNormals_ > 0)
+    warn(str(badNormals_) + " triangle(s) had zero or non-finite vertex normals; flat normals used for them");
+  if (scene_.triangles.empty()) {
+    std::string why = firstSkip_;
+    if (why.empty() && degenerate_ > 0) why = "all " + str(degenerate_) + " triangles have zero area";
+    if (why.empty()) why = "the default scene's nodes reference no mesh triangles";
+    fail("the scene has no triangles to render (" + why + ")");
+  }
+  for (const Triangle& t : scene_.triangles)
+    for (const glm::vec3& p : t.p) scene_.bounds.grow(p);
+}
+
+void SceneBuilder::warnUnsupportedExtensions() {
+  std::string list;
+  for (const std::string& ext : model_.extensionsUsed)
+    if (!isSupportedExtension(ext)) list += (list.empty() ? "" : ", ") + oneLine(ext);
+  if (!list.empty()) warn("ignoring unsupported extension(s): " + list);
+}
+
+// ---- node hierarchy ----
+glm::dmat4 SceneBuilder::localMatrix(const tinygltf::Node& node, const std::string& at) {
+  if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glTF
+  glm::dmat4 m(1.0);
+  if (node.translation.size() == 3)
+    m = glm::translate(m, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4) {
+    glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);  // (w, x, y, z)
+    const double length = glm::length(q);
+    if (!(length > 1e-12) || !std::isfinite(length)) {
+      warn(at + ".rotation is not a unit quaternion (length " + num(length) + "); using no rotation");
+    } else {
+      m *= glm::mat4_cast(q / length);
+    }
+  }
+  if (node.scale.size() == 3) m = glm::scale(m, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+  return m;
+}
+
+// Rejects children out of range, nodes with two parents and cycles, so the walk below terminates.
+std::vector<int> SceneBuilder::checkHierarchy() {
+  const std::size_t n = model_.nodes.size();
+  std::vector<int> parent(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int child : model_.nodes[i].children) {
+      const std::string at = "nodes[" + str(i) + "].children";
+      if (child < 0 || std::size_t(child) >= n)
+        fail(at + " lists node " + std::to_string(child) + ", but the file has " + str(n) + " nodes");
+      if (std::size_t(child) == i) fail(at + " lists the node itself (a cycle in the node graph)");
+      if (parent[std::size_t(child)] >= 0)
+        fail("nodes[" + str(std::uint64_t(child)) + "] has two parents (nodes[" +
+             str(std::uint64_t(parent[std::size_t(child)])) + "] and nodes[" + str(i) +
+             "]); glTF node hierarchies must be trees");
+      parent[std::size_t(child)] = int(i);
+    }
+  }
+  // Every node has at most one parent, so following parents either reaches a root or loops.
+  enum : char { kUnseen, kOnPath, kLeadsToRoot };
+  std::vector<char> state(n, kUnseen);
+  std::vector<std::size_t> path;
+  for (std::size_t start = 0; start < n; ++start) {
+    path.clear();
+    for (std::size_t i = start; state[i] != kLeadsToRoot; i = std::size_t(parent[i])) {
+      if (state[i] == kOnPath)
+        fail("the node graph has a cycle through nodes[" + str(i) + "] (node hierarchies must be trees)");
+      state[i] = kOnPath;
+      path.push_back(i);
+      if (parent[i] < 0) break;
+    }
+    for (std::size_t p : path) state[p] = kLeadsToRoot;
+  }
+  return parent;
+}
+
+void SceneBuilder::traverse() {
+  const std::vector<int> parent = checkHierarchy();
+  std::vector<int> roots;
+  if (model_.scenes.empty()) {
+    for (std::size_t i = 0; i < parent.size(); ++i)
+      if (parent[i] < 0) roots.push_back(int(i));
+  } else {
+    const int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+    if (std::size_t(sceneIndex) >= model_.scenes.size())
+      fail("scene is " + str(std::uint64_t(sceneIndex)) + ", but the file has " + str(model_.scenes.size()) +
+           " scenes");
+    roots = model_.scenes[std::size_t(sceneIndex)].nodes;
+    for (int r : roots)
+      if (r < 0 || std::size_t(r) >= model_.nodes.size())
+        fail("scenes[" + str(std::uint64_t(sceneIndex)) + "].nodes lists node " + std::to_string(r) +
+             ", but the file has " + str(model_.nodes.size()) + " nodes");
+  }
+  // Depth-first, pre-order, children in file order; an explicit stack bounds native recursion.
+  std::vector<bool> visited(model_.nodes.size(), false);
+  std::vector<std::pair<int, glm::dmat4>> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
+  while (!stack.empty()) {
+    const auto [index, parentWorld] = stack.back();
+    stack.pop_back();
+    const std::string at = "nodes[" + str(std::uint64_t(index)) + "]";
+    if (visited[std::size_t(index)]) {
+      warn(at + " is reached twice from the scene's root nodes; the second instance is skipped");
+      continue;
+    }
+    visited[std::size_t(index)] = true;
+    const tinygltf::Node& node = model_.nodes[std::size_t(index)];
+    NodeTransform xf;
+    xf.world = parentWorld * localMatrix(node, at);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(xf.world[c][r])) fail(at + ": its world transform is not finite");
+    if (node.skin >= 0 && !warnedSkin_) {
+      warn(at + ": skins are not supported; meshes are drawn in their bind pose");
+      warnedSkin_ = true;
+    }
+    if (node.camera >= 0) addCamera(node.camera, xf.world, node, at);
+    if (node.mesh >= 0) {
+      const glm::dmat3 m3(xf.world);
+      const double det = glm::determinant(m3);
+      if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) {
+        skip(at + ": its transform is singular (scale 0?); its mesh is skipped");
+      } else {
+        xf.normal = glm::transpose(glm::inverse(m3));
+        xf.flip = det < 0.0;
+        addMesh(node.mesh, xf, at);
+      }
+    }
+    for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, xf.world);
+  }
+}
+
+void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf::Node& node,
+                             const std::string& at) {
+  if (std::size_t(index) >= model_.cameras.size())
+    fail(at + ".camera is " + str(std::uint64_t(index)) + ", but the file has " + str(model_.cameras.size()) +
+         " cameras");
+  const tinygltf::Camera& cam = model_.cameras[std::size_t(index)];
+  const std::string cat = "cameras[" + str(std::uint64_t(index)) + "]";
+  if (cam.type != "perspective") {
+    warn(cat + " is " + oneLine(cam.type) + "; only perspective cameras are used");
+    return;
+  }
+  const double yfov = cam.perspective.yfov;
+  if (!(yfov > 0.0 && yfov < kPiD))
+    fail(cat + ".perspective.yfov is " + num(yfov) + "; it must be an angle in radians between 0 and pi");
+  const glm::dmat3 m3(world);
+  const glm::dvec3 position(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+  const glm::dvec3 f = m3 * glm::dvec3(0.0, 0.0, -1.0);
+  const glm::dvec3 u = m3 * glm::dvec3(0.0, 1.0, 0.0);
+  const double fl = glm::length(f);
+  const glm::dvec3 forward = f / fl;
+  const glm::dvec3 upOrtho = u - glm::dot(u, forward) * forward;
+  const double ul = glm::length(upOrtho);
+  if (!(fl > 1e-12) || !(ul > 1e-9 * std::max(1.0, glm::length(u))) || !std::isfinite(fl) || !std::isfinite(ul)) {
+    warn(at + ": camera transform is degenerate (zero scale, or up parallel to forward); camera skipped");
+    return;
+  }
+  Camera out;
+  out.name = !cam.name.empty() ? cam.name : !node.name.empty() ? node.name : cat;
+  out.position = glm::vec3(position);
+  out.forward = glm::vec3(forward);
+  out.up = glm::vec3(upOrtho / ul);
+  out.yfov = float(yfov);
+  out.aspect = cam.perspective.aspectRatio > 0.0 ? float(cam.perspective.aspectRatio) : 0.0f;
+  scene_.cameras.push_back(out);
+}
+
+// ---- meshes ----
+void SceneBuilder::addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt) {
+  if (std::size_t(meshIndex) >= model_.meshes.size())
+    fail(nodeAt + ".mesh is " + str(std::uint64_t(meshIndex)) + ", but the file has " + str(model_.meshes.size()) +
+         " meshes");
+  const tinygltf::Mesh& mesh = model_.meshes[std::size_t(meshIndex)];
+  for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+    addPrimitive(mesh.primitives[p], xf,
+                 "meshes[" + str(std::uint64_t(meshIndex)) + "].primitives[" + str(p) + "]");
+}
+
+void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at) {
+  static const char* const kModeNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+  if (prim.mode >= 0 && prim.mode <= 3) {
+    skip(at + ": mode " + kModeNames[prim.mode] + " is not supported (triangles only); primitive skipped");
+    return;
+  }
+  if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    skip(at + ": mode " + std::to_string(prim.mode) + " is not a valid primitive mode; primitive skipped");
+    return;
+  }
+  if (!prim.targets.empty() && !warnedTargets_) {
+    warn(at + ": morph targets are not supported; the base shape is used");
+    warnedTargets_ = true;
+  }
+  const auto posIt = prim.attributes.find("POSITION");
+  if (posIt == prim.attributes.end()) {
+    skip(at + " has no POSITION attribute; primitive skipped");
+    return;
+  }
+  const std::vector<double> positions =
+      readAccessor(posIt->second, TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, at + " POSITION");
+  const std::size_t vertexCount = positions.size() / 3;
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (!std::isfinite(positions[i]))
+      fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
+  const std::vector<double> normals = readAttribute(
+      prim, "NORMAL", TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, vertexCount, at);
+  const std::vector<double> uvs =
+      readAttribute(prim, "TEXCOORD_0", TINYGLTF_TYPE_VEC2,
+                    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false},
+                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
+                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
+                    vertexCount, at);
+  for (std::size_t i = 0; i < uvs.size(); ++i)
+    if (!std::isfinite(uvs[i])) fail(at + ": TEXCOORD_0 of vertex " + str(i / 2) + " is not finite");
+
+  std::vector<std::uint32_t> indices;
+  if (prim.indices >= 0) {
+    const std::vector<double> raw =
+        readAccessor(prim.indices, TINYGLTF_TYPE_SCALAR,
+                     {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false},
+                      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false},
+                      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false}},
+                     at + " indices");
+    indices.reserve(raw.size());
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      if (raw[i] >= double(vertexCount))
+        fail(at + ": index " + str(std::uint64_t(raw[i])) + " (entry " + str(i) + ") is out of range: POSITION has " +
+             str(vertexCount) + " vertices");
+      indices.push_back(std::uint32_t(raw[i]));
+    }
+  } else {
+    indices.resize(vertexCount);
+    for (std::size_t i = 0; i < vertexCount; ++i) indices[i] = std::uint32_t(i);
+  }
+
+  std::uint32_t material;
+  if (prim.material >= 0) {
+    if (std::size_t(prim.material) >= model_.materials.size())
+      fail(at + ".material is " + str(std::uint64_t(prim.material)) + ", but the file has " +
+           str(model_.materials.size()) + " materials");
+    material = std::uint32_t(prim.material);
+  } else {
+    material = defaultMaterial(at);
+  }
+
+  // Corner triples in glTF's counter-clockwise order for each mode (glTF 3.7.2.1).
+  const std::size_t n = indices.size();
+  auto corner = [&](std::size_t t, int k) -> std::uint32_t {
+    if (prim.mode == TINYGLTF_MODE_TRIANGLES) return indices[3 * t + std::size_t(k)];
+    if (prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      const std::size_t odd = t % 2;
+      const std::size_t offset[3] = {0, 1 + odd, 2 - odd};
+      return indices[t + offset[k]];
+    }
+    return k == 2 ? indices[0] : indices[t + 1 + std::size_t(k)];  // fan: (i+1, i+2, 0)
+  };
+  std::size_t triangles = 0;
+  if (prim.mode == TINYGLTF_MODE_TRIANGLES) {
+    triangles = n / 3;
+    if (n % 3 != 0)
+      warn(at + ": " + str(n) + " indices are not a multiple of 3; the last " + str(n % 3) + " are ignored");
+  } else if (n >= 3) {
+    triangles = n - 2;
+  }
+  candidates_ += triangles;  // counted before degenerate ones are dropped, so work stays bounded
+  if (candidates_ > kMaxTriangles) fail("the scene has more than " + str(kMaxTriangles) + " triangles");
+
+  for (std::size_t t = 0; t < triangles; ++t) {
+    std::uint32_t v[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};
+    if (xf.flip) std::swap(v[1], v[2]);  // negative determinant: restore counter-clockwise fronts
+    Triangle tri;
+    tri.material = material;
+    bool finite = true;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t i = v[k];
+      const glm::dvec4 p = xf.world * glm::dvec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0);
+      tri.p[k] = glm::vec3(p);
+      finite = finite && std::isfinite(tri.p[k].x) && std::isfinite(tri.p[k].y) && std::isfinite(tri.p[k].z);
+      tri.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
+    }
+    if (!finite) fail(at + ": a vertex position overflows a float after the node transform");
+    const glm::vec3 cross = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+    const float area2 = glm::length(cross);
+    if (!(area2 > 0.0f) || !std::isfinite(area2)) {
+      ++degenerate_;
+      continue;
+    }
+    const glm::vec3 flat = cross / area2;
+    bool smooth = !normals.empty();
+    for (int k = 0; k < 3 && smooth; ++k) {
+      const std::size_t i = v[k];
+      const glm::dvec3 nw = xf.normal * glm::dvec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+      const double len = glm::length(nw);
+      if (!(len > 1e-20) || !std::isfinite(len)) {
+        smooth = false;
+        ++badNormals_;
+      } else {
+        tri.n[k] = glm::vec3(nw / len);
+      }
+    }
+    if (!smooth) tri.n[0] = tri.n[1] = tri.n[2] = flat;
+    scene_.triangles.push_back(tri);
+  }
+}
+
+}  // namespace caustica::gltf
