@@ -115,7 +115,11 @@ class SceneBuilder {
   // ---- node hierarchy (gltf_nodes.cpp) ----
   glm::dmat4 localMatrix(const tinygltf::Node& node, const std::string& at);
   std::vector<int> checkHierarchy();
-  void traverse();
+  void traverse();  // fills cameraInstances_ and meshInstances_
+  // The world-space point (scene units, double) that becomes the float origin: for a scene farther
+  // from the world origin than its size, the centre of the meshes' bounds from their POSITION
+  // accessors' min/max (node origins where those are missing); else 0.
+  glm::dvec3 chooseOrigin() const;
   void addCamera(int index, const glm::dmat4& world, const tinygltf::Node& node, const std::string& at);
 
   // ---- accessors (gltf_accessors.cpp) ----
@@ -148,6 +152,20 @@ class SceneBuilder {
   bool warnedSkin_ = false;
   bool warnedTargets_ = false;
   std::string firstSkip_;  // first reason a primitive was skipped, quoted when nothing is left
+  // Instances met in the node walk, converted once the origin is known.
+  struct CameraInstance {
+    int camera = -1, node = -1;
+    glm::dmat4 world{1.0};
+    std::string at;
+  };
+  struct MeshInstance {
+    int mesh = -1;
+    NodeTransform xf;
+    std::string at;
+  };
+  std::vector<CameraInstance> cameraInstances_;
+  std::vector<MeshInstance> meshInstances_;
+  glm::dvec3 origin_{0.0};  // subtracted from every world position before it becomes float
 };
 
 }  // namespace caustica::gltf

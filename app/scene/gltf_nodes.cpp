@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +22,12 @@ void SceneBuilder::build() {
   warnUnsupportedExtensions();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
   traverse();
+  // Positions become float relative to the scene's centre, computed in double, so a scene far from
+  // the world origin keeps the precision of one near it (docs/stability.md).
+  origin_ = chooseOrigin();
+  scene_.origin = origin_;
+  for (const CameraInstance& c : cameraInstances_) addCamera(c.camera, c.world, model_.nodes[std::size_t(c.node)], c.at);
+  for (const MeshInstance& m : meshInstances_) addMesh(m.mesh, m.xf, m.at);
   if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
   if (badNormals_ > 0)
     warn(str(badNormals_) + " triangle(s) had zero or non-finite vertex normals; flat normals used for them");
@@ -135,7 +142,7 @@ void SceneBuilder::traverse() {
       warn(at + ": skins are not supported; meshes are drawn in their bind pose");
       warnedSkin_ = true;
     }
-    if (node.camera >= 0) addCamera(node.camera, xf.world, node, at);
+    if (node.camera >= 0) cameraInstances_.push_back({node.camera, index, xf.world, at});
     if (node.mesh >= 0) {
       const glm::dmat3 m3(xf.world);
       const double det = glm::determinant(m3);
@@ -144,11 +151,51 @@ void SceneBuilder::traverse() {
       } else {
         xf.normal = glm::transpose(glm::inverse(m3));
         xf.flip = det < 0.0;
-        addMesh(node.mesh, xf, at);
+        meshInstances_.push_back({node.mesh, xf, at});
       }
     }
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, xf.world);
   }
+}
+
+glm::dvec3 SceneBuilder::chooseOrigin() const {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  auto grow = [&](const glm::dvec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  };
+  bool anyBox = false;
+  for (const MeshInstance& m : meshInstances_) {
+    if (m.mesh < 0 || std::size_t(m.mesh) >= model_.meshes.size()) continue;  // addMesh reports it
+    bool boxed = false;
+    for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(m.mesh)].primitives) {
+      const auto pos = prim.attributes.find("POSITION");
+      if (pos == prim.attributes.end() || pos->second < 0 || std::size_t(pos->second) >= model_.accessors.size()) continue;
+      const tinygltf::Accessor& a = model_.accessors[std::size_t(pos->second)];
+      if (a.minValues.size() != 3 || a.maxValues.size() != 3) continue;
+      bool finite = true;
+      for (int k = 0; k < 3; ++k) finite = finite && std::isfinite(a.minValues[k]) && std::isfinite(a.maxValues[k]);
+      if (!finite) continue;
+      for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec4 local((corner & 1) ? a.maxValues[0] : a.minValues[0], (corner & 2) ? a.maxValues[1] : a.minValues[1],
+                               (corner & 4) ? a.maxValues[2] : a.minValues[2], 1.0);
+        grow(glm::dvec3(m.xf.world * local));
+      }
+      boxed = true;
+    }
+    if (boxed) anyBox = true;
+    else grow(glm::dvec3(m.xf.world[3]));  // no usable min/max: the node's own origin
+  }
+  // Without any min/max (which glTF requires of POSITION) the size is unknown: keep world coordinates.
+  if (!anyBox || !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) return glm::dvec3(0.0);
+  const glm::dvec3 centre = 0.5 * (lo + hi);
+  if (!(std::isfinite(centre.x) && std::isfinite(centre.y) && std::isfinite(centre.z))) return glm::dvec3(0.0);
+  // Only a scene farther from the world origin than its own size loses float precision worth
+  // recovering; others keep their glTF coordinates exactly.
+  const glm::dvec3 extent = hi - lo;
+  const double size = std::max(extent.x, std::max(extent.y, extent.z));
+  const double distance = std::max(std::abs(centre.x), std::max(std::abs(centre.y), std::abs(centre.z)));
+  return distance > size ? centre : glm::dvec3(0.0);
 }
 
 void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf::Node& node,
@@ -166,7 +213,7 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
   if (!(yfov > 0.0 && yfov < kPiD))
     fail(cat + ".perspective.yfov is " + num(yfov) + "; it must be an angle in radians between 0 and pi");
   const glm::dmat3 m3(world);
-  const glm::dvec3 position(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+  const glm::dvec3 position = glm::dvec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0)) - origin_;
   const glm::dvec3 f = m3 * glm::dvec3(0.0, 0.0, -1.0);
   const glm::dvec3 u = m3 * glm::dvec3(0.0, 1.0, 0.0);
   const double fl = glm::length(f);
@@ -296,7 +343,7 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     for (int k = 0; k < 3; ++k) {
       const std::size_t i = v[k];
       const glm::dvec4 p = xf.world * glm::dvec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0);
-      tri.p[k] = glm::vec3(p);
+      tri.p[k] = glm::vec3(glm::dvec3(p) - origin_);
       finite = finite && std::isfinite(tri.p[k].x) && std::isfinite(tri.p[k].y) && std::isfinite(tri.p[k].z);
       tri.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
     }

@@ -83,6 +83,10 @@ struct Scene {
   std::vector<Camera> cameras;       // perspective cameras in the default scene's node-visit order (may be empty)
   std::vector<std::string> warnings; // things skipped or approximated, each naming the file
   Bounds bounds;
+  // World-space position (glTF units, double) of this scene's float origin: for a scene farther from
+  // the world origin than its own size, the loader subtracts its centre from every position and
+  // camera before converting to float, so it keeps full float precision; 0 for other scenes.
+  glm::dvec3 origin{0.0};
 };
 
 // Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.

@@ -1,4 +1,4 @@
-// scene_test.cpp — tests of the glTF loader (app/core/scene_gltf.cpp): the shipped scenes, transforms,
+// gltf_loader_test.cpp — tests of the glTF loader (app/scene/gltf_*.cpp): the shipped scenes, transforms,
 // accessor formats, the material contract, cameras, textures, and that bad input only ever throws
 // caustica::Error with a one-line message naming the file.
 #include <doctest/doctest.h>
@@ -90,7 +90,20 @@ struct Gltf {
     doc["accessors"].push_back(acc);
     return int(doc["accessors"].size() - 1);
   }
-  int positions(const std::vector<float>& xyz) { return accessor(xyz, kFloat, "VEC3"); }
+  // POSITION accessors carry min and max, as glTF requires (the loader's rebase reads them).
+  int positions(const std::vector<float>& xyz) {
+    const int index = accessor(xyz, kFloat, "VEC3");
+    std::vector<float> lo(3, std::numeric_limits<float>::infinity()), hi(3, -std::numeric_limits<float>::infinity());
+    for (std::size_t i = 0; i < xyz.size(); ++i) {
+      lo[i % 3] = std::min(lo[i % 3], xyz[i]);
+      hi[i % 3] = std::max(hi[i % 3], xyz[i]);
+    }
+    if (!xyz.empty()) {
+      doc["accessors"][std::size_t(index)]["min"] = lo;
+      doc["accessors"][std::size_t(index)]["max"] = hi;
+    }
+    return index;
+  }
 
   int add(const char* array, const json& value) {
     doc[array].push_back(value);
@@ -370,11 +383,36 @@ TEST_CASE("node transforms: negative scale flips the winding, normals use the in
     const Scene s = g.load(dir);
     REQUIRE(s.triangles.size() == 1);
     const auto& t = s.triangles[0];
-    CHECK(near(t.p[0], glm::vec3(0, 2, 5)));  // (1,0,0) -> scale (2,0,0) -> rotate (0,2,0) -> translate
+    // (1,0,0) -> scale (2,0,0) -> rotate (0,2,0) -> translate; positions are relative to Scene::origin
+    CHECK(near(t.p[0] + glm::vec3(s.origin), glm::vec3(0, 2, 5)));
     for (const auto& n : t.n) {
       CHECK(std::abs(glm::length(n) - 1.0f) < 1e-5f);
       CHECK(near(n, geometricNormal(t)));  // a plain M * n would tilt the normal off the surface
     }
+  }
+  SUBCASE("a small object far from the origin keeps its precision (rebased in double)") {
+    // A 1 mm triangle translated by 1e6: in float world coordinates its vertices would round to
+    // 0.0625; relative to Scene::origin (its centre, in double) they stay exact to ~1e-10.
+    Gltf g;
+    const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions({0, 0, 0, 0.001f, 0, 0, 0, 0.001f, 0})}}},
+                             {"material", g.diffuse()}});
+    g.root({{"mesh", mesh}, {"translation", {1e6, -2e6, 3e6}}});
+    const Scene s = g.load(dir);
+    REQUIRE(s.triangles.size() == 1);
+    const auto& t = s.triangles[0];
+    CHECK(std::abs(s.origin.x - (1e6 + 0.0005)) < 1e-9);  // the centre of the triangle's box
+    CHECK(std::abs(s.origin.y - (-2e6 + 0.0005)) < 1e-9);
+    CHECK(s.origin.z == 3e6);
+    CHECK(std::abs(t.p[1].x - t.p[0].x - 0.001f) < 1e-9f);
+    CHECK(std::abs(t.p[2].y - t.p[0].y - 0.001f) < 1e-9f);
+    CHECK(std::abs(t.p[0].x + 0.0005f) < 1e-9f);
+  }
+  SUBCASE("a scene near the origin keeps its glTF coordinates") {
+    Gltf g;
+    const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", g.diffuse()}});
+    g.root({{"mesh", mesh}, {"translation", {0.5, 0, 0}}});
+    const Scene s = g.load(dir);
+    CHECK(s.origin == glm::dvec3(0.0));
   }
   SUBCASE("matrix equals TRS, and parents compose") {
     Gltf g;
