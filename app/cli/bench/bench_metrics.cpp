@@ -1,5 +1,5 @@
-// bench_metrics.cpp — error metrics, checkpoint schedule, threshold times, hashing, bench/scenes.json
-// parsing and CSV rows for `caustica bench`.
+// bench_metrics.cpp — error metrics, checkpoint schedule, threshold times, batch sizes, hashing,
+// bench/scenes.json parsing, CSV rows and number formatting for `caustica bench`.
 #include "cli/bench/bench_metrics.h"
 
 #include <algorithm>
@@ -153,6 +153,22 @@ double efficiency(double relMseValue, double seconds) {
   if (!(relMseValue > 0.0) || !(seconds > 0.0)) return std::numeric_limits<double>::quiet_NaN();
   return 1.0 / (relMseValue * seconds);
 }
+
+int nextBatchSpp(int sppSoFar, double elapsedSeconds, double targetSeconds, double maxDispatchSeconds) {
+  if (sppSoFar <= 0) return 1;
+  double sppPerSecond = sppSoFar / elapsedSeconds;
+  double wanted = std::ceil((targetSeconds - elapsedSeconds) * sppPerSecond);
+  double cap = std::max(1.0, std::floor(sppPerSecond * maxDispatchSeconds));
+  return static_cast<int>(std::clamp(wanted, 1.0, cap));
+}
+
+std::string formatDouble(const char* printfFormat, double value) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, printfFormat, value);
+  return buf;
+}
+
+std::string formatSci(double value) { return std::isfinite(value) ? formatDouble("%.3g", value) : "n/a"; }
 
 std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t hash) {
   const auto* p = static_cast<const unsigned char*>(data);

@@ -1,6 +1,7 @@
 // bench_metrics.h — the arithmetic of `caustica bench` (no OpenGL): relative MSE against a reference,
 // the reference's own noise from two independent halves, log-spaced checkpoints, time to reach an
-// error threshold, FNV-1a hashing for the reference cache, bench/scenes.json and the CSV rows.
+// error threshold, the batch size of a progressive run, FNV-1a hashing for the reference cache,
+// bench/scenes.json, the CSV rows and number formatting for the report.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -70,6 +71,16 @@ std::string formatThresholdTime(const ThresholdTime& t);
 
 // Efficiency of a Monte Carlo estimator: 1 / (relMSE * seconds); constant once error ~ 1/time.
 double efficiency(double relMse, double seconds);
+
+// Samples per pixel for the next dispatch of a progressive run that holds `sppSoFar` spp after
+// `elapsedSeconds` of rendering: enough to reach `targetSeconds` at the rate so far, but no more than
+// `maxDispatchSeconds` of work, and at least 1. Before the first dispatch (sppSoFar 0): 1.
+int nextBatchSpp(int sppSoFar, double elapsedSeconds, double targetSeconds, double maxDispatchSeconds);
+
+// One number through a printf format that takes one double ("%.6g", "%.2fx"); up to 63 characters.
+std::string formatDouble(const char* printfFormat, double value);
+// Three significant digits ("0.0259", "1.23e+06"); "n/a" when not finite.
+std::string formatSci(double value);
 
 // FNV-1a, 64-bit. Chain calls by passing the previous hash as `hash`.
 constexpr std::uint64_t kFnv1a64Offset = 0xcbf29ce484222325ull;

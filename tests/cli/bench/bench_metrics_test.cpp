@@ -1,5 +1,6 @@
 // bench_metrics_test.cpp — the benchmark's arithmetic: relMSE and its crop, the reference-noise
-// estimate against a known truth, checkpoint spacing, threshold times, FNV-1a, scenes.json and CSV.
+// estimate against a known truth, checkpoint spacing, threshold times, batch sizes, FNV-1a,
+// scenes.json, CSV and number formatting.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -176,6 +177,30 @@ TEST_CASE("time to threshold interpolates on log-log axes and extrapolates as 1/
 
   CHECK(efficiency(0.01, 4.0) == doctest::Approx(25.0));
   CHECK(std::isnan(efficiency(0.0, 1.0)));
+}
+
+TEST_CASE("progressive batches aim at the next checkpoint, capped at the longest dispatch") {
+  // Before the first dispatch there is no rate yet: one sample per pixel.
+  CHECK(nextBatchSpp(0, 0.0, 0.25, 0.1) == 1);
+  // 128 spp in 1 s: 0.0625 s more to the checkpoint is 8 spp; the cap is floor(12.8) = 12 spp.
+  CHECK(nextBatchSpp(128, 1.0, 1.0625, 0.1) == 8);
+  CHECK(nextBatchSpp(128, 1.0, 2.0, 0.1) == 12);
+  CHECK(nextBatchSpp(128, 1.0, 2.0, 1.0) == 128);
+  // Already past the target (the caller moves on): still at least one.
+  CHECK(nextBatchSpp(128, 1.0, 0.5, 0.1) == 1);
+  // Slower than one spp per dispatch time: one at a time.
+  CHECK(nextBatchSpp(5, 1.0, 3.0, 0.1) == 1);
+}
+
+TEST_CASE("numbers are formatted with three significant digits, n/a when not finite") {
+  CHECK(formatSci(0.0259) == "0.0259");
+  CHECK(formatSci(1234567.0) == "1.23e+06");
+  CHECK(formatSci(13.04) == "13");
+  CHECK(formatSci(std::nan("")) == "n/a");
+  CHECK(formatSci(INFINITY) == "n/a");
+  CHECK(formatDouble("%.2fx", 1.5) == "1.50x");
+  CHECK(formatDouble("%.6g", 0.2007168) == "0.200717");
+  CHECK(formatDouble(" casters=%g", 0.3f) == " casters=0.3");
 }
 
 TEST_CASE("FNV-1a 64 matches the published test vectors and chains") {

@@ -70,7 +70,8 @@ if(CMAKE_SCRIPT_MODE_FILE)
 endif()
 
 # ---- included from tests/CMakeLists.txt ---------------------------------------------------------
-# The metrics unit tests (bench_metrics_test.cpp) are built into cli_tests by tests/CMakeLists.txt.
+# The unit tests (bench_metrics_test.cpp, reference_cache_test.cpp, report_test.cpp) are built into
+# cli_tests by tests/CMakeLists.txt.
 find_program(CAUSTICA_GNUPLOT gnuplot)
 add_test(NAME "bench: smoke run writes CSV, plot and summary, then reuses the cached reference"
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:caustica> -DOUT=${CMAKE_CURRENT_BINARY_DIR}/bench_smoke

@@ -1,0 +1,243 @@
+// bench_runner.cpp — the bench per scene: its settings and caustic region, a reference per dispersion
+// mode, and one progressive run per estimator whose error is measured at log-spaced checkpoints.
+#include "cli/bench/bench_runner.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "cli/bench/bench_metrics.h"
+#include "cli/bench/reference_cache.h"
+#include "cli/bench/report.h"
+#include "platform/context.h"
+#include "scene/assets.h"
+#include "util/error.h"
+#include "util/file_io.h"
+
+namespace caustica::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kFirstCheckpoint = 0.25;  // seconds
+constexpr int kCheckpointsPerOctave = 2;
+constexpr int kDefaultReferenceSpp = 1024;
+constexpr double kMaxDispatchSeconds = 0.1;  // longest single dispatch we aim for (GPU watchdogs, progress)
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream s(text);
+  std::string item;
+  while (std::getline(s, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// Where bench/scenes.json is: --scenes-json, else next to the bundled scenes, else the source tree.
+std::string findScenesJson(const Options& opts) {
+  if (opts.has("--scenes-json")) return opts.get("--scenes-json", "");
+  std::vector<fs::path> candidates = {fs::path(assetSceneDir()) / ".." / ".." / "bench" / "scenes.json",
+                                      fs::path(assetSceneDir()) / ".." / "bench" / "scenes.json",
+                                      fs::path(CAUSTICA_SOURCE_DIR) / "bench" / "scenes.json"};
+  for (const auto& c : candidates) {
+    std::error_code ec;
+    if (fs::is_regular_file(c, ec)) return fs::weakly_canonical(c, ec).string();
+  }
+  return "";
+}
+
+class BenchRunner {
+ public:
+  explicit BenchRunner(const Options& opts) : opts_(opts) {
+    quiet_ = opts.has("--quiet");
+    setup_.maxSeconds = opts.getDouble("--max-seconds", 20.0);
+    if (!(setup_.maxSeconds > 0.0)) throw Error("option --max-seconds needs a positive number of seconds");
+    referenceSpp_ = opts.getInt("--reference-spp", kDefaultReferenceSpp, 2, 1 << 24);
+    referenceSpp_ += referenceSpp_ % 2;  // two equal halves
+    outDir_ = opts.get("--out", "bench-out");
+    cacheDir_ = opts.get("--cache", defaultReferenceCacheDir());
+    for (const auto& name : splitList(opts.get("--integrators", "naive,mis")))
+      integrators_.push_back(parseIntegrator(name));
+    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis");
+    for (const auto& name : splitList(opts.get("--dispersion", "rgb,spectral")))
+      dispersions_.push_back(parseDispersionMode(name));
+    if (dispersions_.empty()) throw Error("option --dispersion needs at least one of rgb, spectral");
+    std::string scenesJson = findScenesJson(opts);
+    if (!scenesJson.empty()) sceneInfo_ = parseBenchScenes(readFileText(scenesJson), scenesJson);
+    else note(quiet_, "warning: bench/scenes.json not found: no caustic regions (use --scenes-json FILE)");
+    std::error_code ec;
+    fs::create_directories(outDir_, ec);
+    if (ec) throw Error(outDir_ + ": cannot create the output folder (" + ec.message() + ")");
+  }
+
+  int run() {
+    std::vector<std::string> scenes = opts_.positional();
+    if (scenes.empty()) scenes = assetSceneNames();
+    if (scenes.empty()) throw Error(assetSceneDir() + ": no bundled scenes found");
+    if (opts_.has("--reference") && scenes.size() != 1)
+      throw Error("--reference gives one image: name exactly one scene (got " + std::to_string(scenes.size()) + ")");
+    // Resolve every scene first so that a typo fails before minutes of rendering.
+    std::vector<std::string> paths;
+    for (const auto& s : scenes) paths.push_back(resolveScenePath(s));
+
+    std::string glInfo;
+    auto context = createHeadlessContext(parseBackend(opts_.get("--backend", "auto")), &glInfo);
+    setup_.backend = context->backendName();
+    setup_.glRenderer = glRendererName(glInfo);
+    note(quiet_, "OpenGL (" + setup_.backend + "): " + glInfo);
+    ShaderLibrary library = shaderLibraryFrom(opts_);
+    ReferenceCache cache(cacheDir_, opts_.has("--refresh-reference"), setup_.glRenderer, quiet_);
+    auto start = Clock::now();
+    for (const auto& path : paths) benchScene(library, cache, path);
+    writeSummary(outDir_, summaryMarkdown(setup_, secondsSince(start), all_), quiet_);
+    return 0;
+  }
+
+ private:
+  void benchScene(const ShaderLibrary& library, const ReferenceCache& cache, const std::string& path) {
+    const std::string name = fs::path(path).stem().string();
+    LoadedScene ls = loadSceneForCli(path, opts_, !quiet_);
+    ReferenceRequest request;
+    request.cameraIndex = cameraIndexFrom(opts_);
+    const RenderSettings settings = renderSettingsFrom(opts_, ls.camera, 256);
+    request.scenePath = path;
+    request.sceneName = name;
+    request.measured = settings;
+    auto info = sceneInfo_.find(name);
+    request.spp = referenceSpp_;  // --reference-spp, else scenes.json, else the default
+    if (!opts_.has("--reference-spp") && info != sceneInfo_.end() && info->second.referenceSpp > 0)
+      request.spp = info->second.referenceSpp;
+    if (info != sceneInfo_.end() && info->second.caustic)
+      request.caustic = cropToPixels(*info->second.caustic, settings.width, settings.height);
+    else if (info == sceneInfo_.end() && !sceneInfo_.empty())
+      note(quiet_, "warning: " + name + " is not in bench/scenes.json: no caustic region");
+    const std::optional<PixelRect>& caustic = request.caustic;
+
+    Renderer renderer(library, ls.scene, ls.camera, settings);
+    std::vector<DispersionMode> modes;
+    if (renderer.gpuScene().features.dispersion) modes = dispersions_;
+    else modes = {DispersionMode::Rgb};  // the mode changes nothing without dispersive glass
+    if (opts_.has("--reference") && modes.size() != 1)
+      throw Error("--reference gives one image but " + name + " is benchmarked in " + std::to_string(modes.size()) +
+                  " dispersion modes: pick one with --dispersion");
+    note(quiet_, name + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, features: " +
+                     renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
+                     std::to_string(settings.height) +
+                     (caustic ? ", caustic region " + std::to_string(caustic->width()) + "x" +
+                                    std::to_string(caustic->height()) + " px at (" + std::to_string(caustic->x0) +
+                                    ", " + std::to_string(caustic->y0) + ")"
+                              : ", no caustic region"));
+
+    std::vector<RunResult> results;
+    for (DispersionMode mode : modes) {
+      request.mode = mode;
+      Reference ref = opts_.has("--reference")
+                          ? givenReference(opts_.get("--reference", ""), settings.width, settings.height, quiet_)
+                          : cache.get(library, ls, request, renderer);
+      writeReferencePreview(outDir_, name, dispersionModeName(mode), ref.image, caustic);
+      for (Integrator integrator : integrators_) {  // the cache left the renderer in the reference's settings
+        RenderSettings run = settings;
+        run.dispersion = mode;
+        run.integrator = integrator;
+        renderer.apply(run);
+        results.push_back(measure(renderer, name, ref, caustic));
+      }
+    }
+    std::string csv = writeSceneCsv(outDir_, name, results);
+    note(quiet_, "wrote " + csv);
+    writePlot(outDir_, name, gnuplotScript(setup_, name, settings.width, settings.height, results),
+              opts_.get("--gnuplot", "gnuplot"), quiet_);
+    for (auto& r : results) all_.push_back(std::move(r));
+  }
+
+  // One progressive run: renders in batches sized to land just past each checkpoint; the clock
+  // counts rendering only (the read-back and error at each checkpoint are excluded).
+  RunResult measure(Renderer& renderer, const std::string& name, const Reference& ref,
+                    const std::optional<PixelRect>& caustic) {
+    const RenderSettings& s = renderer.settings();
+    RunResult out;
+    out.scene = name;
+    out.integrator = estimatorName(s, !renderer.gpuScene().casters.empty());
+    out.dispersion = dispersionModeName(s.dispersion);
+    out.noise = ref.noise;
+    out.noiseCaustic = ref.noiseCaustic;
+    out.referenceSpp = ref.spp;
+    out.hasCaustic = caustic.has_value();
+    renderer.renderPass(1);  // compiles this shader variant outside the clock
+    renderer.reset();
+    const std::vector<double> schedule = checkpointSchedule(kFirstCheckpoint, setup_.maxSeconds, kCheckpointsPerOctave);
+    const double pixels = double(s.width) * s.height;
+    double elapsed = 0.0;  // seconds of rendering so far
+    size_t next = 0;       // the next checkpoint in `schedule`
+    while (next < schedule.size()) {
+      int n = nextBatchSpp(renderer.samplesPerPixel(), elapsed, schedule[next], kMaxDispatchSeconds);
+      auto t0 = Clock::now();
+      renderer.renderPass(n);
+      elapsed += secondsSince(t0);
+      if (elapsed < schedule[next]) continue;
+      while (next < schedule.size() && schedule[next] <= elapsed) ++next;
+
+      const RenderStats& st = renderer.stats();
+      Image img = renderer.image();
+      BenchRow row;
+      row.scene = name;
+      row.integrator = out.integrator;
+      row.dispersion = out.dispersion;
+      row.glRenderer = setup_.glRenderer;
+      row.width = s.width;
+      row.height = s.height;
+      row.checkpoint = static_cast<int>(out.rows.size());
+      row.seconds = elapsed;
+      row.spp = renderer.samplesPerPixel();
+      row.samplesPerSecond = row.spp * pixels / elapsed;
+      row.raysPerSecond = double(st.rays()) / elapsed;
+      row.primaryRays = st.primaryRays;
+      row.secondaryRays = st.secondaryRays;
+      row.shadowRays = st.shadowRays;
+      row.nonFinite = st.nonFinite;
+      row.relMse = relMse(img, ref.image);
+      row.relMseCaustic = caustic ? relMse(img, ref.image, *caustic) : std::nan("");
+      row.referenceNoise = ref.noise;
+      row.referenceNoiseCaustic = ref.noiseCaustic;
+      out.rows.push_back(row);
+      if (!quiet_) {
+        std::fprintf(stderr, "\rcaustica: %s %s/%s: %6.2f s %6d spp  relMSE %.3g%s   ", name.c_str(),
+                     out.integrator.c_str(), out.dispersion.c_str(), elapsed, row.spp, row.relMse,
+                     caustic ? (", caustic " + formatSci(row.relMseCaustic)).c_str() : "");
+        std::fflush(stderr);
+      }
+    }
+    if (!quiet_) std::fprintf(stderr, "\n");
+    if (out.rows.back().nonFinite > 0)
+      note(quiet_, "warning: " + name + " " + out.integrator + ": " + std::to_string(out.rows.back().nonFinite) +
+                       " non-finite samples were rejected");
+    return out;
+  }
+
+  const Options& opts_;
+  bool quiet_ = false;
+  BenchSetup setup_;  // GL renderer, backend and --max-seconds
+  int referenceSpp_ = kDefaultReferenceSpp;
+  std::string outDir_, cacheDir_;
+  std::vector<Integrator> integrators_;
+  std::vector<DispersionMode> dispersions_;
+  std::map<std::string, BenchSceneInfo> sceneInfo_;
+  std::vector<RunResult> all_;  // every run of every scene so far, for the summary
+};
+
+}  // namespace
+
+int runBench(const Options& opts) {
+  BenchRunner bench(opts);
+  return bench.run();
+}
+
+}  // namespace caustica::cli
