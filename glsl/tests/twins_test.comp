@@ -1,0 +1,134 @@
+// twins_test.comp — GPU test entry: runs one GLSL library function (chosen by a uniform) on a batch of
+// input records, so that tests/gpu/twins_gpu_test.cpp can compare it with its C++ twin (app/shading/sampling.h).
+// One invocation per record; #version is injected by the host; no feature defines are needed.
+#include "../shared/gpu_layout.h"
+#include "../lib/rng.glsl"
+#include "../lib/sampling.glsl"
+#include "../lib/spectral.glsl"
+#include "../lib/materials.glsl"
+#include "../lib/casters.glsl"
+
+layout(local_size_x = 64) in;
+
+// bindings.glsl is not included, so SSBO bindings 0 and 1 are free (GL 4.3 guarantees only 0-7).
+// Per record kInWords uvec4: uint arguments as they are, float arguments as their bits.
+layout(std430, binding = 0) readonly buffer InBuffer { uvec4 inRec[]; };
+// Per record kOutWords uvec4: results as uint, float results as their bits, bools as 0 or 1.
+layout(std430, binding = 1) writeonly buffer OutBuffer { uvec4 outRec[]; };
+
+layout(location = 0) uniform uint recordCount;
+layout(location = 1) uniform uint function;  // one of the constants below (enum Fn in the test)
+
+const uint kInWords = 4u;
+const uint kOutWords = 11u;
+
+const uint kPcgHash = 0u;
+const uint kRngSeed = 1u;
+const uint kRand01 = 2u;
+const uint kLuminance = 3u;
+const uint kOrthonormalBasis = 4u;
+const uint kSampleCosineHemisphere = 5u;
+const uint kSampleTriangleUniform = 6u;
+const uint kPowerHeuristic = 7u;
+const uint kFresnelDielectric = 8u;
+const uint kRefractDir = 9u;
+const uint kOffsetRayOrigin = 10u;
+const uint kSampleDielectric = 11u;
+const uint kCauchyIor = 12u;
+const uint kChannelSensitivity = 13u;
+const uint kInCone = 14u;
+const uint kCasterCone = 15u;
+const uint kSampleUniformCone = 16u;
+const uint kCasterFacesLights = 17u;
+const uint kPrepareCasters = 18u;
+const uint kDiffuseDirectionPdf = 19u;
+const uint kSampleDiffuseDirection = 20u;
+
+uvec4 bits(vec4 v) { return floatBitsToUint(v); }
+uvec4 bits(vec3 v, float w) { return floatBitsToUint(vec4(v, w)); }
+uint bit(bool b) { return b ? 1u : 0u; }
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= recordCount) return;
+  uvec4 raw[kInWords];
+  vec4 a[kInWords];
+  for (uint k = 0u; k < kInWords; ++k) {
+    raw[k] = inRec[i * kInWords + k];
+    a[k] = uintBitsToFloat(raw[k]);
+  }
+  uvec4 o[kOutWords];
+  for (uint k = 0u; k < kOutWords; ++k) o[k] = uvec4(0u);
+
+  if (function == kPcgHash) {
+    o[0].x = pcgHash(raw[0].x);
+  } else if (function == kRngSeed) {
+    o[0].x = rngSeed(raw[0].x, raw[0].y, raw[0].z);
+  } else if (function == kRand01) {  // three draws, then the state
+    uint state = raw[0].x;
+    o[0].x = floatBitsToUint(rand01(state));
+    o[0].y = floatBitsToUint(rand01(state));
+    o[0].z = floatBitsToUint(rand01(state));
+    o[0].w = state;
+  } else if (function == kLuminance) {
+    o[0].x = floatBitsToUint(luminance(a[0].xyz));
+  } else if (function == kOrthonormalBasis) {
+    vec3 t, b;
+    orthonormalBasis(a[0].xyz, t, b);
+    o[0] = bits(t, 0.0);
+    o[1] = bits(b, 0.0);
+  } else if (function == kSampleCosineHemisphere) {
+    o[0] = bits(sampleCosineHemisphere(a[0].xy), 0.0);
+  } else if (function == kSampleTriangleUniform) {
+    o[0] = bits(vec4(sampleTriangleUniform(a[0].xy), 0.0, 0.0));
+  } else if (function == kPowerHeuristic) {
+    o[0].x = floatBitsToUint(powerHeuristic(a[0].x, a[0].y));
+  } else if (function == kFresnelDielectric) {
+    o[0].x = floatBitsToUint(fresnelDielectric(a[0].x, a[0].y));
+  } else if (function == kRefractDir) {  // a[0] = (d, eta), a[1].xyz = n
+    vec3 t;
+    bool ok = refractDir(a[0].xyz, a[1].xyz, a[0].w, t);
+    o[0] = bits(t, 0.0);
+    o[0].w = bit(ok);
+  } else if (function == kOffsetRayOrigin) {  // a[0].xyz = p, a[1].xyz = n
+    o[0] = bits(offsetRayOrigin(a[0].xyz, a[1].xyz), 0.0);
+  } else if (function == kSampleDielectric) {  // a[0] = (d, eta), a[1] = (n, u)
+    vec3 wi;
+    bool transmitted;
+    float f = sampleDielectric(a[0].xyz, a[1].xyz, a[0].w, a[1].w, wi, transmitted);
+    o[0] = bits(wi, f);
+    o[1].x = bit(transmitted);
+  } else if (function == kCauchyIor) {  // a[0].xyz = (iorD, abbe, lambda)
+    o[0].x = floatBitsToUint(cauchyIor(a[0].x, a[0].y, a[0].z));
+  } else if (function == kChannelSensitivity) {
+    o[0] = bits(channelSensitivity(a[0].x), 0.0);
+  } else if (function == kInCone) {  // a[0] = (w, 1 - cos), a[1].xyz = axis
+    o[0].x = bit(inCone(a[0].xyz, a[1].xyz, a[0].w));
+  } else if (function == kCasterCone) {  // a[0].xyz = p, a[1].xyz = n, a[2] = sphere
+    vec3 axis;
+    float omc;
+    bool ok = casterCone(a[0].xyz, a[1].xyz, a[2], axis, omc);
+    o[0] = bits(axis, omc);
+    o[1].x = bit(ok);
+  } else if (function == kSampleUniformCone) {  // a[0] = (axis, 1 - cos), a[1].xy = u
+    o[0] = bits(sampleUniformCone(a[0].xyz, a[0].w, a[1].xy), 0.0);
+  } else if (function == kCasterFacesLights) {  // a[0] = (p, margin), a[1] = (axis, 1 - cos), a[2] = lights
+    o[0].x = bit(casterFacesLights(a[0].xyz, a[1].xyz, a[1].w, a[2], a[0].w));
+  } else if (function == kPrepareCasters) {  // a[0] = (p, u), a[1].xyz = n; spheres and lights from the UBO
+    prepareCasters(a[0].xyz, a[1].xyz, a[0].w);
+    o[0].xy = uvec2(gCasterUsable, gCasterPick);
+    for (uint k = 0u; k < uint(CAUSTICA_MAX_CASTERS); ++k) {
+      if (k >= gCasterUsable) break;
+      o[1u + k] = bits(gCasterAxis[k], gCasterOneMinusCos[k]);
+      o[9u + k / 4u][k % 4u] = floatBitsToUint(gCasterInvSolidAngle[k]);
+    }
+  } else if (function == kDiffuseDirectionPdf) {  // prepareCasters as above, a[2].xyz = w
+    prepareCasters(a[0].xyz, a[1].xyz, a[0].w);
+    o[0].x = floatBitsToUint(diffuseDirectionPdf(a[1].xyz, a[2].xyz));
+  } else if (function == kSampleDiffuseDirection) {  // prepareCasters as above, a[1].w = uPick, a[3].xy = u
+    prepareCasters(a[0].xyz, a[1].xyz, a[0].w);
+    o[0] = bits(sampleDiffuseDirection(a[1].xyz, a[1].w, a[3].xy), 0.0);
+  }
+
+  for (uint k = 0u; k < kOutWords; ++k) outRec[i * kOutWords + k] = o[k];
+}

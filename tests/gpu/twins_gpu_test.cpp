@@ -1,0 +1,758 @@
+// twins_gpu_test.cpp — the GLSL rng, sampling, Fresnel, dielectric, spectral and caster functions
+// (tests/twins_test.comp on llvmpipe) agree with their C++ twins in app/shading/sampling.h, function for
+// function, on random and edge-case inputs. Each tolerance says what it was measured against;
+// CAUSTICA_TWINS_REPORT=1 prints every measured maximum.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "gpu/gl_objects.h"
+#include "gpu/shader_library.h"
+#include "shading/sampling.h"
+
+using namespace caustica;
+
+namespace {
+
+// Function numbers of twins_test.comp, in its order.
+enum class Fn : GLuint {
+  PcgHash, RngSeed, Rand01, Luminance, OrthonormalBasis, SampleCosineHemisphere, SampleTriangleUniform,
+  PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
+  ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
+  DiffuseDirectionPdf, SampleDiffuseDirection
+};
+
+constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
+
+// Float bits to uints and back (memcpy: glm's vector floatBitsToUint casts through a reference, which
+// GCC's aliasing rules break).
+template <class To, class From>
+To sameBits(const From& v) {
+  static_assert(sizeof(To) == sizeof(From));
+  To out;
+  std::memcpy(&out, &v, sizeof out);
+  return out;
+}
+
+// One input record: the shader reads word k as uints (raw[k]) or as float bits (a[k]).
+struct In {
+  glm::uvec4 w[kInWords] = {};
+};
+In floats(const glm::vec4& a, const glm::vec4& b = glm::vec4(0), const glm::vec4& c = glm::vec4(0),
+          const glm::vec4& d = glm::vec4(0)) {
+  In r;
+  r.w[0] = sameBits<glm::uvec4>(a);
+  r.w[1] = sameBits<glm::uvec4>(b);
+  r.w[2] = sameBits<glm::uvec4>(c);
+  r.w[3] = sameBits<glm::uvec4>(d);
+  return r;
+}
+In uints(const glm::uvec4& a) {
+  In r;
+  r.w[0] = a;
+  return r;
+}
+glm::vec4 arg(const In& r, int k) { return sameBits<glm::vec4>(r.w[k]); }
+
+// One output record: uints, float bits, or bools as 0 and 1.
+struct Out {
+  glm::uvec4 w[kOutWords];
+  float f(int word, int c = 0) const { return sameBits<float>(w[word][c]); }
+  glm::vec3 v(int word) const { return sameBits<glm::vec3>(glm::uvec3(w[word])); }
+  bool b(int word, int c = 0) const { return w[word][c] != 0u; }
+};
+static_assert(sizeof(In) == kInWords * 16 && sizeof(Out) == kOutWords * 16, "records are packed uvec4 arrays");
+
+// twins_test.comp, compiled once per test case; run() calls one function on every record.
+class GlslTwins {
+ public:
+  GlslTwins() {
+    ExpandedShader src = ShaderLibrary().expand("tests/twins_test.comp", {});
+    prog_ = GlProgram::compileCompute(
+        src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/twins_test.comp");
+  }
+  std::vector<Out> run(Fn fn, const std::vector<In>& in, const gpu::CasterParams& casters = {}) const {
+    GlBuffer inBuf = GlBuffer::fromVector(in);
+    GlBuffer outBuf = GlBuffer::create(sizeof(Out) * in.size(), nullptr);
+    GlBuffer ubo = GlBuffer::create(sizeof(casters), &casters);
+    prog_.use();
+    inBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    outBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    ubo.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
+    glUniform1ui(0, static_cast<GLuint>(in.size()));
+    glUniform1ui(1, static_cast<GLuint>(fn));
+    glDispatchCompute(static_cast<GLuint>((in.size() + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    checkGlError("twins test dispatch");
+    std::vector<Out> out(in.size());
+    outBuf.read(0, out.size() * sizeof(Out), out.data());
+    return out;
+  }
+
+ private:
+  GlProgram prog_;
+};
+
+std::string str(float x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.9g", static_cast<double>(x));
+  return b;
+}
+std::string str(const glm::vec3& v) { return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ")"; }
+std::string str(const glm::vec4& v) { return "(" + str(glm::vec3(v)) + ", " + str(v.w) + ")"; }
+std::string str(const In& r) {
+  return "inputs " + str(arg(r, 0)) + " " + str(arg(r, 1)) + " " + str(arg(r, 2)) + " " + str(arg(r, 3));
+}
+
+bool reportWanted() { return std::getenv("CAUSTICA_TWINS_REPORT") != nullptr; }
+
+// The largest GPU-vs-C++ difference of one output over all records, checked against its tolerance;
+// keeps a description of the worst record for the message.
+class MaxDiff {
+ public:
+  MaxDiff(std::string what, double tol) : what_(std::move(what)), tol_(tol) {}
+  void add(double diff, const std::function<std::string()>& describe) {
+    if (std::isnan(worst_) || diff <= worst_) return;  // a NaN difference sticks
+    worst_ = diff;
+    where_ = describe();
+  }
+  void check() const {
+    if (reportWanted()) MESSAGE(what_, ": max difference ", worst_, " (tolerance ", tol_, ") at ", where_);
+    INFO(what_, ": max difference ", worst_, " exceeds the tolerance ", tol_, " at ", where_);
+    CHECK(worst_ <= tol_);
+  }
+
+ private:
+  std::string what_;
+  double tol_, worst_ = 0;
+  std::string where_ = "-";
+};
+
+// A discrete output (bool, integer, bits) that must agree exactly, except on records the caller marks as
+// lying on a threshold (the C++ twin itself flips there under a tiny change of the input); those are
+// counted and must stay rare.
+class Mismatches {
+ public:
+  explicit Mismatches(std::string what) : what_(std::move(what)) {}
+  void add(bool same, bool onThreshold, const std::function<std::string()>& describe) {
+    ++records_;
+    if (same) return;
+    if (onThreshold) {
+      ++onThreshold_;
+      return;
+    }
+    if (count_++ == 0) first_ = describe();
+  }
+  void add(bool same, const std::function<std::string()>& describe) { add(same, false, describe); }
+  void check() const {
+    if (reportWanted())
+      MESSAGE(what_, ": ", count_, " mismatches, ", onThreshold_, " on a threshold, of ", records_, " records");
+    INFO(what_, ": ", count_, " of ", records_, " records differ; first: ", first_);
+    CHECK(count_ == 0);
+    INFO(what_, ": ", onThreshold_, " of ", records_, " records differ on a threshold");
+    CHECK(onThreshold_ * 50 <= records_);  // at most 2%: the edge cases aim at thresholds, random inputs rarely
+  }
+
+ private:
+  std::string what_, first_;
+  int records_ = 0, count_ = 0, onThreshold_ = 0;
+};
+
+constexpr double kEps = std::numeric_limits<float>::epsilon();  // 2^-23, one ULP of 1
+
+// Where a discrete output decides on a threshold (a comparison of rounded floats), GPU and C++ may
+// disagree when a few-ULP difference in an intermediate crosses it: a record counts as on the threshold
+// when the C++ twin itself flips as the input that decides moves by kNudge (relative, about 8 ULP).
+constexpr float kNudge = 1e-6f;
+
+// llvmpipe's GLSL asin (Mesa 22.3) is a polynomial approximation: measured against std::asin on
+// [0, 1] its absolute error reaches 3.9e-4 rad (near x = 0.94; 2e-4 at x = 0.5), against a few ULP in
+// C++. casterFacesLights compares 2 asin(a) with asin(b) + asin(c) + margin, so its GPU and C++ answers
+// may differ where those sides are within 4 x 4e-4 rad of each other; there it counts as on the threshold.
+constexpr float kAsinBand = 4.0f * 4e-4f;
+
+double absDiff(const glm::vec3& a, const glm::vec3& b) {
+  glm::vec3 d = glm::abs(a - b);
+  return std::max({d.x, d.y, d.z});
+}
+double absDiff(float a, float b) { return std::abs(static_cast<double>(a) - b); }
+// Relative difference; below `floor` in magnitude it turns into an absolute difference scaled by 1 / floor.
+double relDiff(float gpu, float cpu, double floor = 1e-30) {
+  return absDiff(gpu, cpu) / std::max(std::abs(static_cast<double>(cpu)), floor);
+}
+
+enum class Measure { Absolute, Relative };
+
+// Runs `fn` on every record and compares output word 0 (a float in .x, or a vec3) with twin(record).
+template <class Twin>
+void compareOutput(const GlslTwins& gpu, Fn fn, const std::vector<In>& in, MaxDiff diff, Measure measure,
+                   const Twin& twin) {
+  std::vector<Out> out = gpu.run(fn, in);
+  for (size_t i = 0; i < in.size(); ++i) {
+    auto c = twin(in[i]);
+    if constexpr (std::is_same_v<decltype(c), float>) {
+      float g = out[i].f(0);
+      diff.add(measure == Measure::Relative ? relDiff(g, c) : absDiff(g, c),
+               [&] { return str(in[i]) + ": " + str(g) + " vs " + str(c); });
+    } else {
+      glm::vec3 g = out[i].v(0);
+      diff.add(absDiff(g, c), [&] { return str(in[i]) + ": " + str(g) + " vs " + str(c); });
+    }
+  }
+  diff.check();
+}
+
+struct Random {
+  std::mt19937 g;
+  explicit Random(std::uint32_t seed) : g(seed) {}
+  float uniform(float a = 0.0f, float b = 1.0f) { return std::uniform_real_distribution<float>(a, b)(g); }
+  float logUniform(float lo, float hi) { return std::pow(10.0f, uniform(std::log10(lo), std::log10(hi))); }
+  glm::vec3 unit() {
+    std::normal_distribution<float> n;
+    glm::vec3 v;
+    do v = glm::vec3(n(g), n(g), n(g));
+    while (glm::dot(v, v) < 1e-6f);
+    return glm::normalize(v);
+  }
+  glm::vec3 inBox(float h) { return glm::vec3(uniform(-h, h), uniform(-h, h), uniform(-h, h)); }
+  glm::vec2 u2() { return glm::vec2(uniform(), uniform()); }
+};
+
+const float kLastBelowOne = std::nextafter(1.0f, 0.0f);  // the largest rand01
+const float kUEdges[] = {0.0f, 1e-7f, 0.25f, 0.5f, 0.75f, 1.0f - 1e-6f, kLastBelowOne};
+
+// Unit normals at and near the poles, where orthonormalBasis switches sign, and along the axes.
+std::vector<glm::vec3> edgeNormals() {
+  std::vector<glm::vec3> ns = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {1, 0, -0.0f}, {0, 1, -0.0f}};
+  for (float eps : {0.0f, 1e-8f, 1e-6f, 1e-4f, 1e-2f})
+    for (float z : {1.0f, -1.0f})
+      for (int k = 0; k < 4; ++k) {
+        float phi = 0.4f + 1.5707964f * static_cast<float>(k);
+        ns.push_back(glm::normalize(glm::vec3(eps * std::cos(phi), eps * std::sin(phi), z)));
+      }
+  return ns;
+}
+
+// A unit direction d towards a surface with unit normal n, at cos(angle) = cosI against -n.
+glm::vec3 incident(const glm::vec3& n, float cosI, Random& r) {
+  glm::vec3 t = glm::normalize(glm::cross(n, r.unit()));
+  return glm::normalize(-cosI * n + std::sqrt(std::max(0.0f, 1.0f - cosI * cosI)) * t);
+}
+
+// How far the C++ twin's output moves when eta changes by a relative kNudge. Near the critical angle
+// refraction is ill-conditioned: a one-ULP difference in cos(incidence) (a dot product, which llvmpipe
+// rounds differently) moves the refracted direction by up to this much, so it is added to the tolerance.
+template <class F>
+double etaSpread(const F& f, float eta) {
+  auto base = f(eta);
+  return std::max(absDiff(f(eta * (1.0f - kNudge)), base), absDiff(f(eta * (1.0f + kNudge)), base));
+}
+
+const float kEtas[] = {1.5f, 1.0f / 1.5f, 1.33f, 1.0f / 1.33f, 2.4f, 1.0f / 2.4f, 1.0f, 1.0001f, 0.9999f};
+
+}  // namespace
+
+TEST_CASE("GLSL rng functions equal their C++ twins bit for bit: pcgHash, rngSeed, rand01") {
+  GlslTwins gpu;
+  Random r(1);
+  std::vector<In> in;
+  for (std::uint32_t v : {0u, 1u, 0x7fffffffu, 0x80000000u, 0xffffffffu}) in.push_back(uints({v, v, v, 0}));
+  // rand01's first draw is (pcgHash(state) >> 8) / 2^24: states giving exactly 0 and 1 - 2^-24.
+  for (std::uint32_t want : {0u, 0xffffffu}) {
+    std::uint32_t v = 0;
+    while ((pcgHash(v) >> 8u) != want) ++v;
+    in.push_back(uints({v, 0, 0, 0}));
+  }
+  for (std::uint32_t i = 0; i < 1024; ++i) in.push_back(uints({i, i & 7u, 1u, 0}));
+  while (in.size() < 8192) in.push_back(uints({r.g(), r.g(), r.g(), 0}));
+
+  // Integer arithmetic, and float(24-bit integer) * 2^-24, are exact on both sides: every bit must agree.
+  std::vector<Out> hash = gpu.run(Fn::PcgHash, in), seed = gpu.run(Fn::RngSeed, in), draws = gpu.run(Fn::Rand01, in);
+  Mismatches mHash("pcgHash"), mSeed("rngSeed"), mRand("rand01 (three draws, then the state)");
+  for (size_t i = 0; i < in.size(); ++i) {
+    glm::uvec4 a = in[i].w[0];
+    std::uint32_t h = pcgHash(a.x), s = rngSeed(a.x, a.y, a.z);
+    auto args = [&] { return "uints " + std::to_string(a.x) + " " + std::to_string(a.y) + " " + std::to_string(a.z); };
+    mHash.add(hash[i].w[0].x == h, args);
+    mSeed.add(seed[i].w[0].x == s, args);
+    std::uint32_t state = a.x;
+    float u0 = rand01(state), u1 = rand01(state), u2 = rand01(state);
+    glm::uvec4 want(sameBits<std::uint32_t>(u0), sameBits<std::uint32_t>(u1), sameBits<std::uint32_t>(u2), state);
+    mRand.add(draws[i].w[0] == want, args);
+  }
+  mHash.check();
+  mSeed.check();
+  mRand.check();
+}
+
+TEST_CASE(
+    "GLSL sampling helpers equal their C++ twins: luminance, orthonormalBasis, sampleCosineHemisphere, "
+    "sampleTriangleUniform, powerHeuristic") {
+  GlslTwins gpu;
+  Random r(2);
+  const size_t n = 4096;
+
+  std::vector<In> colours = {floats({0, 0, 0, 0}), floats({1, 1, 1, 0}), floats({1e30f, 1e30f, 1e30f, 0})};
+  while (colours.size() < n)
+    colours.push_back(floats(glm::vec4(glm::abs(r.inBox(1.0f)) * r.logUniform(1e-3f, 1e3f), 0)));
+  // One dot product, rounded in another order or fused on llvmpipe: measured 1.6e-7 (1.3 ULP).
+  compareOutput(gpu, Fn::Luminance, colours, MaxDiff("luminance (relative)", 4 * kEps), Measure::Relative,
+                [](const In& x) { return luminance(glm::vec3(arg(x, 0))); });
+
+  std::vector<In> normals;
+  for (const glm::vec3& nn : edgeNormals()) normals.push_back(floats(glm::vec4(nn, 0)));
+  while (normals.size() < n) normals.push_back(floats(glm::vec4(r.unit(), 0)));
+  std::vector<Out> basis = gpu.run(Fn::OrthonormalBasis, normals);
+  // A handful of products and sums of magnitude <= 2: measured 1.2e-7 (one ULP of 1).
+  MaxDiff dBasis("orthonormalBasis t and b", 4 * kEps);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 t, b;
+    orthonormalBasis(glm::vec3(arg(normals[i], 0)), t, b);
+    dBasis.add(std::max(absDiff(basis[i].v(0), t), absDiff(basis[i].v(1), b)), [&] {
+      return str(normals[i]) + ": t " + str(basis[i].v(0)) + " vs " + str(t) + ", b " + str(basis[i].v(1)) + " vs " +
+             str(b);
+    });
+  }
+  dBasis.check();
+
+  std::vector<In> us;
+  for (float a : kUEdges)
+    for (float b : kUEdges) us.push_back(floats({a, b, 0, 0}));
+  while (us.size() < n) us.push_back(floats(glm::vec4(r.u2(), 0, 0)));
+  // llvmpipe's cos and sin of phi in [0, 2 pi) are within ~1 ULP: measured 6e-8.
+  compareOutput(gpu, Fn::SampleCosineHemisphere, us, MaxDiff("sampleCosineHemisphere", 4 * kEps), Measure::Absolute,
+                [](const In& x) { return sampleCosineHemisphere(glm::vec2(arg(x, 0))); });
+  // A sqrt, a product and a difference: measured 0 (one ULP allowed: GLSL does not require a correctly
+  // rounded sqrt). The shader writes (b1, b2, 0).
+  compareOutput(gpu, Fn::SampleTriangleUniform, us, MaxDiff("sampleTriangleUniform", kEps), Measure::Absolute,
+                [](const In& x) { return glm::vec3(sampleTriangleUniform(glm::vec2(arg(x, 0))), 0.0f); });
+
+  std::vector<In> pdfs = {floats({0, 1, 0, 0}),        floats({-1, 1, 0, 0}),         floats({1, 0, 0, 0}),
+                          floats({1, 1, 0, 0}),        floats({1e-30f, 1e30f, 0, 0}), floats({1e30f, 1e-30f, 0, 0}),
+                          floats({1.2e-38f, 1, 0, 0}), floats({1e20f, 3e20f, 0, 0})};
+  while (pdfs.size() < n) pdfs.push_back(floats({r.logUniform(1e-20f, 1e20f), r.logUniform(1e-20f, 1e20f), 0, 0}));
+  // A division and a few products: measured 0 (one ULP allowed: GLSL division need not be correctly rounded).
+  compareOutput(gpu, Fn::PowerHeuristic, pdfs, MaxDiff("powerHeuristic", kEps), Measure::Absolute,
+                [](const In& x) { return powerHeuristic(arg(x, 0).x, arg(x, 0).y); });
+}
+
+TEST_CASE("GLSL Fresnel, refraction, ray offset and dielectric sampling equal their C++ twins") {
+  GlslTwins gpu;
+  Random r(3);
+  const size_t n = 4096;
+
+  // fresnelDielectric: eta = n_t / n_i on both sides of 1; cosI at normal and grazing incidence, out of
+  // [0, 1] (clamped), and around the critical angle of total internal reflection (eta < 1).
+  std::vector<In> fr;
+  for (float eta : kEtas) {
+    std::vector<float> cs = {0.0f, -0.0f, 1e-6f, 1e-3f, 0.5f, 1.0f, -0.1f, 1.1f};
+    if (eta < 1.0f) {
+      float crit = std::sqrt(1.0f - eta * eta);
+      for (float k : {0.0f, 1e-6f, -1e-6f, 1e-4f, -1e-4f, 1e-2f, -1e-2f}) cs.push_back(crit * (1.0f + k));
+      cs.push_back(std::nextafter(crit, 0.0f));
+      cs.push_back(std::nextafter(crit, 1.0f));
+    }
+    for (float c : cs) fr.push_back(floats({c, eta, 0, 0}));
+  }
+  while (fr.size() < n)
+    fr.push_back(
+        floats({r.uniform(-0.2f, 1.2f), fr.size() % 2 ? kEtas[fr.size() % 9] : r.logUniform(0.3f, 3.3f), 0, 0}));
+  std::vector<Out> fres = gpu.run(Fn::FresnelDielectric, fr);
+  // Measured 0, also at the critical angle (one ULP allowed for division); beyond the spread because a
+  // driver that rounds sin2T differently by one ULP moves the result that much near the critical angle.
+  MaxDiff dFres("fresnelDielectric (beyond its spread under eta * (1 +- kNudge))", kEps);
+  for (size_t i = 0; i < n; ++i) {
+    float cosI = arg(fr[i], 0).x, eta = arg(fr[i], 0).y, c = fresnelDielectric(cosI, eta), g = fres[i].f(0);
+    double spread = etaSpread([&](float e) { return fresnelDielectric(cosI, e); }, eta);
+    dFres.add(absDiff(g, c) - spread, [&] { return str(fr[i]) + ": " + str(g) + " vs " + str(c); });
+  }
+  dFres.check();
+
+  // refractDir and sampleDielectric: d towards the surface, n against d; random, grazing and critical
+  // angles; u at the Fresnel reflectance, where sampleDielectric switches from reflection to refraction.
+  std::vector<In> rays;
+  auto addRay = [&](const glm::vec3& nn, float cosI, float eta) {
+    float u = rays.size() % 2 ? r.uniform() : fresnelDielectric(cosI, eta);
+    rays.push_back(floats(glm::vec4(incident(nn, cosI, r), eta), glm::vec4(nn, u)));
+  };
+  for (float eta : kEtas)
+    for (float cosI : {1.0f, 0.5f, 1e-2f, 1e-4f, 1e-6f})
+      for (int k = 0; k < 2; ++k) addRay(r.unit(), cosI, eta);
+  for (float eta : kEtas) {  // refractDir's eta = n_i / n_t: total internal reflection when eta > 1
+    if (eta <= 1.0f) continue;
+    float crit = std::sqrt(1.0f - 1.0f / (eta * eta));
+    for (float k : {0.0f, 1e-6f, -1e-6f, 1e-4f, -1e-4f, 1e-2f, -1e-2f}) addRay(r.unit(), crit * (1.0f + k), eta);
+  }
+  while (rays.size() < n) {
+    glm::vec3 nn = r.unit(), d = r.unit();
+    if (glm::dot(d, nn) > 0.0f) d = -d;
+    float eta = rays.size() % 2 ? kEtas[rays.size() % 9] : r.logUniform(0.3f, 3.3f);
+    rays.push_back(floats(glm::vec4(d, eta), glm::vec4(nn, r.uniform())));
+  }
+  std::vector<Out> refr = gpu.run(Fn::RefractDir, rays), diel = gpu.run(Fn::SampleDielectric, rays);
+  Mismatches mRefr("refractDir: refracts (else total internal reflection)"), mDiel("sampleDielectric: transmitted");
+  // Directions: dot products and normalize (GLSL: inversesqrt) differ by an ULP or two; beyond the spread
+  // measured 6e-8 (refractDir) and 1.2e-7 (sampleDielectric, also reflect). Without the spread the worst
+  // record, 2e-4 from the critical angle, differed by 3e-4. Factor 1 / eta^2: measured 0.
+  MaxDiff dRefr("refractDir direction (beyond its spread)", 4 * kEps),
+      dDiel("sampleDielectric direction (beyond its spread)", 4 * kEps),
+      dDielF("sampleDielectric throughput factor (relative)", kEps);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 d(arg(rays[i], 0)), nn(arg(rays[i], 1));
+    float eta = arg(rays[i], 0).w, u = arg(rays[i], 1).w;
+    struct Refraction {
+      bool ok;
+      glm::vec3 t;
+    };
+    auto refract = [&](float e) {
+      Refraction x;
+      x.ok = refractDir(d, nn, e, x.t);
+      return x;
+    };
+    Refraction c = refract(eta);
+    mRefr.add(refr[i].b(0, 3) == c.ok, refract(eta * (1.0f - kNudge)).ok != refract(eta * (1.0f + kNudge)).ok,
+              [&] { return str(rays[i]); });
+    if (c.ok == refr[i].b(0, 3))
+      dRefr.add(absDiff(refr[i].v(0), c.t) - etaSpread([&](float e) { return refract(e).t; }, eta),
+                [&] { return str(rays[i]) + ": " + str(refr[i].v(0)) + " vs " + str(c.t); });
+
+    struct Sample {
+      float factor;
+      glm::vec3 wi;
+      bool transmitted;
+    };
+    auto dielectric = [&](float e) {
+      Sample x;
+      x.factor = sampleDielectric(d, nn, e, u, x.wi, x.transmitted);
+      return x;
+    };
+    Sample cs = dielectric(eta);
+    mDiel.add(diel[i].b(1) == cs.transmitted,
+              dielectric(eta * (1.0f - kNudge)).transmitted != dielectric(eta * (1.0f + kNudge)).transmitted,
+              [&] { return str(rays[i]); });
+    if (diel[i].b(1) == cs.transmitted) {
+      dDiel.add(absDiff(diel[i].v(0), cs.wi) - etaSpread([&](float e) { return dielectric(e).wi; }, eta),
+                [&] { return str(rays[i]) + ": " + str(diel[i].v(0)) + " vs " + str(cs.wi); });
+      dDielF.add(relDiff(diel[i].f(0, 3), cs.factor),
+                 [&] { return str(rays[i]) + ": " + str(diel[i].f(0, 3)) + " vs " + str(cs.factor); });
+    }
+  }
+  mRefr.check();
+  dRefr.check();
+  mDiel.check();
+  dDiel.check();
+  dDielF.check();
+
+  // offsetRayOrigin: both branches (|p| below and above 1/32) and their border, signs, zeros, large p,
+  // normals whose 256 n truncates to 0 in some components. Integer steps on the float bits, and
+  // p + 2^-16 n (an exact product, one rounded sum), are exact on both sides: every bit must agree.
+  std::vector<In> offs;
+  const float kBorder = 1.0f / 32.0f;
+  const float edges[] = {
+      0.0f,  -0.0f, kBorder, -kBorder, std::nextafter(kBorder, 0.0f), -std::nextafter(kBorder, 0.0f), 1.0f,
+      -1.0f, 1e4f,  -1e4f,   1e-6f};
+  for (float e : edges)
+    for (const glm::vec3& nn : {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::normalize(glm::vec3(1, -2, 3)),
+                                glm::normalize(glm::vec3(1e-3f, -1e-3f, 1))})
+      offs.push_back(floats(glm::vec4(e, -e, e, 0), glm::vec4(nn, 0)));
+  while (offs.size() < n)
+    offs.push_back(floats(glm::vec4(r.inBox(1.0f) * r.logUniform(1e-4f, 1e4f), 0), glm::vec4(r.unit(), 0)));
+  std::vector<Out> off = gpu.run(Fn::OffsetRayOrigin, offs);
+  Mismatches mOff("offsetRayOrigin (bit for bit)");
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 c = offsetRayOrigin(glm::vec3(arg(offs[i], 0)), glm::vec3(arg(offs[i], 1)));
+    mOff.add(glm::uvec3(off[i].w[0]) == sameBits<glm::uvec3>(c),
+             [&] { return str(offs[i]) + ": " + str(off[i].v(0)) + " vs " + str(c); });
+  }
+  mOff.check();
+}
+
+TEST_CASE("GLSL spectral functions equal their C++ twins: cauchyIor, channelSensitivity") {
+  GlslTwins gpu;
+  Random r(4);
+  const size_t n = 4096;
+  // cauchyIor: the three Fraunhofer lines and the range ends; no dispersion (abbe 0 or below).
+  std::vector<In> ior;
+  for (float lambda : {380.0f, 486.1f, 587.6f, 656.3f, 780.0f})
+    for (float abbe : {0.0f, -1.0f, 20.0f, 60.0f}) ior.push_back(floats({1.5f, abbe, lambda, 0}));
+  while (ior.size() < n) {
+    float abbe = ior.size() % 10 == 0 ? 0.0f : r.uniform(15.0f, 90.0f);
+    ior.push_back(floats({r.uniform(1.3f, 2.5f), abbe, r.uniform(380.0f, 780.0f), 0}));
+  }
+  // Divisions and sums only: measured 0 (one ULP allowed for division).
+  compareOutput(gpu, Fn::CauchyIor, ior, MaxDiff("cauchyIor (relative)", kEps), Measure::Relative,
+                [](const In& x) { return cauchyIor(arg(x, 0).x, arg(x, 0).y, arg(x, 0).z); });
+
+  // channelSensitivity: the channel means, the range ends and beyond (tails down to underflow).
+  std::vector<In> lambdas;
+  for (float l : {380.0f, 460.0f, 545.0f, 610.0f, 780.0f, 300.0f, 900.0f}) lambdas.push_back(floats({l, 0, 0, 0}));
+  while (lambdas.size() < n) lambdas.push_back(floats({r.uniform(300.0f, 900.0f), 0, 0, 0}));
+  std::vector<Out> sens = gpu.run(Fn::ChannelSensitivity, lambdas);
+  // exp(x) inherits the rounding of its argument x = -(lambda - mean)^2 / (2 sigma^2), so its relative
+  // error grows with |x| (about |ln W|): the relative difference is divided by 1 + |ln W|.
+  // Measured 1.3e-7 (about one ULP per unit of |x|; raw relative differences reach 9e-6 in the far tail).
+  MaxDiff dSens("channelSensitivity (relative, over 1 + |ln W|)", 4 * kEps);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 c = channelSensitivity(arg(lambdas[i], 0).x), g = sens[i].v(0);
+    for (int k = 0; k < 3; ++k)
+      dSens.add(relDiff(g[k], c[k]) / (1.0 + std::abs(std::log(std::max(c[k], 1e-30f)))),
+                [&] { return str(lambdas[i]) + ": " + str(g) + " vs " + str(c); });
+  }
+  dSens.check();
+}
+
+TEST_CASE("GLSL caster functions equal their C++ twins: inCone, casterCone, sampleUniformCone, casterFacesLights") {
+  GlslTwins gpu;
+  Random r(5);
+  const size_t n = 4096;
+
+  // inCone: directions sampled in cones 0.5 to 1.5 times as wide, so that about half lie inside; the
+  // axis itself; directions on the rim of the cone with its 1e-4 slack.
+  std::vector<In> cone;
+  while (cone.size() < n) {
+    glm::vec3 axis = cone.size() % 8 == 0 ? edgeNormals()[cone.size() / 8 % edgeNormals().size()] : r.unit();
+    float omc = cone.size() % 16 == 1 ? kCasterMinOneMinusCos : r.logUniform(1e-5f, 1.0f);
+    float scale = r.uniform(0.5f, 1.5f);
+    if (cone.size() % 32 == 3) scale = 1.0001f * (1.0f + (cone.size() % 64 == 3 ? kNudge : -kNudge));
+    glm::vec2 u = cone.size() % 32 == 3 ? glm::vec2(1.0f, r.uniform()) : r.u2();
+    glm::vec3 w = cone.size() % 32 == 2 ? axis : sampleUniformCone(axis, std::min(2.0f, omc * scale), u);
+    cone.push_back(floats(glm::vec4(w, omc), glm::vec4(axis, 0)));
+  }
+  std::vector<Out> inside = gpu.run(Fn::InCone, cone);
+  Mismatches mIn("inCone");
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 w(arg(cone[i], 0)), axis(arg(cone[i], 1));
+    float omc = arg(cone[i], 0).w;
+    mIn.add(inside[i].b(0) == inCone(w, axis, omc),
+            inCone(w, axis, omc * (1 - kNudge)) != inCone(w, axis, omc * (1 + kNudge)), [&] { return str(cone[i]); });
+  }
+  mIn.check();
+
+  // casterCone: random spheres seen from 1e-3 to 1.2 radii away (inside, far and narrower than the
+  // narrowest cone aimed at), points on the sphere, cones at the narrowest 1 - cos, cones at the horizon of n.
+  std::vector<In> spheres;
+  while (spheres.size() < n) {
+    glm::vec3 p = r.inBox(2.0f), c = r.inBox(2.0f), nn = r.unit();
+    float dist = glm::length(c - p), rad = dist * r.logUniform(1e-3f, 1.2f);
+    glm::vec3 axis = (c - p) / dist;
+    float k = spheres.size() % 3 == 0 ? 0.0f : (spheres.size() % 3 == 1 ? 1e-6f : -1e-4f);
+    switch (spheres.size() % 8) {
+      case 1:  // on the sphere (with its 1e-4 slack)
+        rad = dist / std::sqrt(1.0001f) * (1.0f + k);
+        break;
+      case 2:  // the narrowest cone aimed at
+        rad = dist * std::sqrt(kCasterMinOneMinusCos * (2.0f - kCasterMinOneMinusCos)) * (1.0f + k);
+        break;
+      case 3: {  // the cone touches the horizon of n: dot(n, axis) = -sin(half angle)
+        float s = rad / dist * (1.0f + k);
+        glm::vec3 perp = glm::normalize(glm::cross(axis, r.unit()));
+        nn = glm::normalize(-s * axis + std::sqrt(std::max(0.0f, 1.0f - s * s)) * perp);
+        break;
+      }
+      default:
+        break;
+    }
+    spheres.push_back(floats(glm::vec4(p, 0), glm::vec4(nn, 0), glm::vec4(c, rad)));
+  }
+  std::vector<Out> cones = gpu.run(Fn::CasterCone, spheres);
+  Mismatches mCone("casterCone: usable");
+  // Axis: d / sqrt(dot(d, d)), measured 1.2e-7 (one ULP of 1). 1 - cos = sin2 / (1 + sqrt(1 - sin2)) is
+  // ill-conditioned next to the sphere (sin2 -> 1): compared beyond its spread under radius * (1 +- kNudge).
+  MaxDiff dAxis("casterCone axis", 4 * kEps), dOmc("casterCone 1 - cos (relative, beyond its spread)", 4 * kEps);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 p(arg(spheres[i], 0)), nn(arg(spheres[i], 1)), axis;
+    glm::vec4 s = arg(spheres[i], 2);
+    float omc;
+    bool ok = casterCone(p, nn, s, axis, omc);
+    // The C++ twin with the radius scaled and n tilted by kNudge towards the axis (dot(n, axis) is
+    // compared with -sin of the half angle: an absolute rounding, which a relative radius change misses).
+    auto at = [&](float radiusScale, float tilt, float& o) {
+      glm::vec3 a;
+      return casterCone(p, glm::normalize(nn + tilt * axis), glm::vec4(glm::vec3(s), s.w * radiusScale), a, o);
+    };
+    float o0, o1, o2, o3;
+    bool onThreshold =
+        at(1.0f - kNudge, 0.0f, o0) != at(1.0f + kNudge, 0.0f, o1) || at(1.0f, -kNudge, o2) != at(1.0f, kNudge, o3);
+    const Out& g = cones[i];
+    bool same = g.b(1) == ok;
+    mCone.add(same, onThreshold,
+              [&] { return str(spheres[i]) + ": " + std::to_string(g.b(1)) + " vs " + std::to_string(ok); });
+    if (!same) continue;  // also the axis and 1 - cos: a rejected sphere leaves them at their defaults
+    dAxis.add(absDiff(g.v(0), axis), [&] { return str(spheres[i]) + ": " + str(g.v(0)) + " vs " + str(axis); });
+    double spread = std::max(relDiff(o0, omc), relDiff(o1, omc));
+    dOmc.add(relDiff(g.f(0, 3), omc) - spread,
+             [&] { return str(spheres[i]) + ": " + str(g.f(0, 3)) + " vs " + str(omc); });
+  }
+  mCone.check();
+  dAxis.check();
+  dOmc.check();
+
+  // sampleUniformCone: axes at and near the poles of orthonormalBasis, cones from the narrowest to the sphere.
+  std::vector<In> uc;
+  for (const glm::vec3& axis : edgeNormals())
+    for (float omc : {kCasterMinOneMinusCos, 1e-3f, 1.0f, 2.0f})
+      for (float u : kUEdges) uc.push_back(floats(glm::vec4(axis, omc), glm::vec4(u, 1.0f - u, 0, 0)));
+  while (uc.size() < n) uc.push_back(floats(glm::vec4(r.unit(), r.logUniform(1e-5f, 2.0f)), glm::vec4(r.u2(), 0, 0)));
+  // orthonormalBasis, cos and sin of phi, normalize: measured 1.8e-7 (1.5 ULP of 1). Narrow cones stay
+  // sensitive: at 1 - cos = 1e-5 the direction is 4.5e-3 from the axis, 1e4 times this tolerance.
+  compareOutput(gpu, Fn::SampleUniformCone, uc, MaxDiff("sampleUniformCone", 4 * kEps), Measure::Absolute,
+                [](const In& x) { return sampleUniformCone(glm::vec3(arg(x, 0)), arg(x, 0).w, glm::vec2(arg(x, 1))); });
+
+  // casterFacesLights: random caster cones and light spheres (also none: radius < 0, and p inside it),
+  // and lights placed just outside the band of kAsinBand around the angle where the answer switches
+  // (the cones' half angles plus the margin), a few right on it.
+  std::vector<In> faces;
+  const float margins[] = {0.0f, 0.05f, 0.2f};
+  while (faces.size() < n) {
+    glm::vec3 p = r.inBox(2.0f), axis = r.unit(), lc = r.inBox(2.0f);
+    float omc = r.logUniform(1e-5f, 0.5f), lr = r.logUniform(0.01f, 1.0f), margin = margins[faces.size() % 3];
+    if (faces.size() % 20 == 0) lr = -1.0f;
+    if (faces.size() % 20 == 1) lr = glm::length(lc - p) * 1.01f;
+    if (faces.size() % 4 == 2) {
+      float dist = r.uniform(0.5f, 3.0f);
+      lr = dist * r.uniform(0.01f, 0.5f);
+      float angle = std::asin(lr / dist) + std::asin(std::sqrt(omc * (2.0f - omc))) + margin;
+      angle += faces.size() % 64 == 2 ? 0.0f : (faces.size() % 8 == 2 ? 2.0f : -2.0f) * kAsinBand;
+      glm::vec3 perp = glm::normalize(glm::cross(axis, r.unit()));
+      lc = p + dist * (std::cos(angle) * axis + std::sin(angle) * perp);
+    }
+    faces.push_back(floats(glm::vec4(p, margin), glm::vec4(axis, omc), glm::vec4(lc, lr)));
+  }
+  std::vector<Out> facing = gpu.run(Fn::CasterFacesLights, faces);
+  Mismatches mFaces("casterFacesLights");
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec4 a0 = arg(faces[i], 0), a1 = arg(faces[i], 1), lights = arg(faces[i], 2);
+    auto facesAt = [&](float margin) { return casterFacesLights(glm::vec3(a0), glm::vec3(a1), a1.w, lights, margin); };
+    bool c = facesAt(a0.w);
+    mFaces.add(facing[i].b(0) == c, facesAt(a0.w - kAsinBand) != facesAt(a0.w + kAsinBand),
+               [&] { return str(faces[i]) + ": " + std::to_string(facing[i].b(0)) + " vs " + std::to_string(c); });
+  }
+  mFaces.check();
+}
+
+namespace {
+
+// A CasterParams block: `count` random spheres (refractive where refractMask has the bit), the lights'
+// bounding sphere, the probability of aiming at a caster and the margin.
+gpu::CasterParams casterScene(Random& r, std::uint32_t count, std::uint32_t refractMask, const glm::vec4& lights,
+                              float probability, float margin) {
+  gpu::CasterParams c{};
+  c.count = glm::uvec4(count, refractMask, 0, 0);
+  c.params = glm::vec4(probability, margin, 0, 0);
+  c.lights = lights;
+  for (std::uint32_t i = 0; i < count; ++i) c.sphere[i] = glm::vec4(r.inBox(2.0f), r.logUniform(0.02f, 0.6f));
+  return c;
+}
+
+// The C++ twin on the spheres of a CasterParams block, with every radius scaled and the margin shifted.
+CasterVertex prepareCasters(const gpu::CasterParams& c, const glm::vec3& p, const glm::vec3& n, float u,
+                            float radiusScale = 1.0f, float marginShift = 0.0f) {
+  glm::vec4 spheres[CasterVertex::kMax];
+  for (int i = 0; i < CasterVertex::kMax; ++i)
+    spheres[i] = glm::vec4(glm::vec3(c.sphere[i]), c.sphere[i].w * radiusScale);
+  return caustica::prepareCasters(p, n, u, spheres, c.count.x, c.count.y, c.lights, c.params.y + marginShift);
+}
+
+}  // namespace
+
+TEST_CASE("GLSL caster state equals its C++ twin: prepareCasters, diffuseDirectionPdf, sampleDiffuseDirection") {
+  GlslTwins gpu;
+  Random r(6);
+  const size_t n = 4096;
+  const gpu::CasterParams scenes[] = {
+      casterScene(r, 8, 0xa5u, glm::vec4(0.0f, 2.5f, 0.0f, 1.0f), 0.3f, 0.1f),  // every slot, some refractive
+      casterScene(r, 3, 0x3u, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.5f, 0.0f),  // no lights: refractive ones never
+      casterScene(r, 5, 0x0u, glm::vec4(1.0f, 1.0f, 1.0f, 0.5f), 0.9f, 0.2f),   // mirrors only
+      casterScene(r, 0, 0x0u, glm::vec4(0.0f, 2.5f, 0.0f, 0.4f), 0.3f, 0.05f),  // none: cosine sampling only
+  };
+  for (const gpu::CasterParams& scene : scenes) {
+    CAPTURE(scene.count.x);
+    // Points anywhere (also inside spheres), u at the ends; w for the pdf: sampled as the shader would
+    // (in some cone when a caster is picked, up to its rim), or any direction; uPick also at the caster probability.
+    std::vector<In> in;
+    while (in.size() < n) {
+      glm::vec3 p = r.inBox(3.0f), nn = r.unit();
+      float u = in.size() % 64 == 0 ? 0.0f : (in.size() % 64 == 1 ? kLastBelowOne : r.uniform());
+      CasterVertex v = prepareCasters(scene, p, nn, u);
+      glm::vec2 uw(in.size() % 8 == 1 ? 1.0f : r.uniform(), r.uniform());
+      glm::vec3 w = in.size() % 2 ? sampleDiffuseDirection(v, scene.params.x, nn, r.uniform(), uw) : r.unit();
+      float uPick = in.size() % 16 == 5 ? scene.params.x : r.uniform();  // at the probability: cosine sampling
+      in.push_back(floats(glm::vec4(p, u), glm::vec4(nn, uPick), glm::vec4(w, 0), glm::vec4(r.u2(), 0, 0)));
+    }
+    std::vector<Out> prep = gpu.run(Fn::PrepareCasters, in, scene), pdf = gpu.run(Fn::DiffuseDirectionPdf, in, scene),
+                     dir = gpu.run(Fn::SampleDiffuseDirection, in, scene);
+    Mismatches mUsable("prepareCasters: usable and pick");
+    // Per usable caster as casterCone (measured: axis 1.2e-7, 1 - cos 2.5e-7 relative, away from the
+    // sphere); 1 / (2 pi (1 - cos)) adds a product and a division: measured 3.4e-7.
+    // diffuseDirectionPdf: relative where the caster term dominates (pdf > 1), absolute where the cosine
+    // term does (dot(n, w) carries an absolute rounding); beyond its spread as the rims move: measured 2.8e-7.
+    // sampleDiffuseDirection: as sampleUniformCone or cosine sampling in orthonormalBasis: measured 1.8e-7.
+    MaxDiff dAxis("prepareCasters axis", 4 * kEps), dOmc("prepareCasters 1 - cos (relative)", 4 * kEps),
+        dInv("prepareCasters 1 / solid angle (relative)", 8 * kEps),
+        dPdf("diffuseDirectionPdf (relative above 1, absolute below; beyond its spread)", 8 * kEps),
+        dDir("sampleDiffuseDirection", 4 * kEps);
+    int usableRecords = 0, refusedByLights = 0, acceptedByLights = 0;
+    for (size_t i = 0; i < n; ++i) {
+      glm::vec3 p(arg(in[i], 0)), nn(arg(in[i], 1)), w(arg(in[i], 2));
+      float u = arg(in[i], 0).w, uPick = arg(in[i], 1).w;
+      CasterVertex v = prepareCasters(scene, p, nn, u);
+      const Out& g = prep[i];
+      bool same = g.w[0].x == v.usable && g.w[0].y == v.pick;
+      CasterVertex lo = prepareCasters(scene, p, nn, u, 1.0f - kNudge, -kAsinBand),
+                   hi = prepareCasters(scene, p, nn, u, 1.0f + kNudge, kAsinBand);
+      mUsable.add(same, lo.usable != hi.usable || lo.pick != hi.pick, [&] {
+        return str(in[i]) + ": " + std::to_string(g.w[0].x) + ", " + std::to_string(g.w[0].y) + " vs " +
+               std::to_string(v.usable) + ", " + std::to_string(v.pick);
+      });
+      if (!same) continue;
+      usableRecords += v.usable > 0;
+      gpu::CasterParams mirrorsOnly = scene;
+      mirrorsOnly.count.y = 0;
+      refusedByLights += prepareCasters(mirrorsOnly, p, nn, u).usable > v.usable;
+      gpu::CasterParams noLights = scene;
+      noLights.lights.w = -1.0f;  // refractive casters never usable
+      acceptedByLights += prepareCasters(noLights, p, nn, u).usable < v.usable;
+      for (std::uint32_t k = 0; k < v.usable; ++k) {
+        auto where = [&] { return str(in[i]) + ", caster " + std::to_string(k); };
+        dAxis.add(absDiff(g.v(1 + k), v.axis[k]), where);
+        dOmc.add(relDiff(g.f(1 + k, 3), v.oneMinusCos[k]), where);
+        dInv.add(relDiff(g.f(9 + k / 4, k % 4), v.invSolidAngle[k]), where);
+      }
+      // The pdf jumps at the rims of the cones: its spread is how far it moves as every rim moves by kNudge.
+      auto pdfAt = [&](float rimScale) {
+        CasterVertex moved = v;
+        for (std::uint32_t k = 0; k < v.usable; ++k) moved.oneMinusCos[k] *= rimScale;
+        return diffuseDirectionPdf(moved, scene.params.x, nn, w);
+      };
+      float cPdf = pdfAt(1.0f), gPdf = pdf[i].f(0);
+      double spread = std::max(absDiff(pdfAt(1.0f - kNudge), cPdf), absDiff(pdfAt(1.0f + kNudge), cPdf));
+      dPdf.add((absDiff(gPdf, cPdf) - spread) / std::max(1.0, std::abs(static_cast<double>(cPdf))),
+               [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
+      glm::vec3 cDir = sampleDiffuseDirection(v, scene.params.x, nn, uPick, glm::vec2(arg(in[i], 3)));
+      dDir.add(absDiff(dir[i].v(0), cDir), [&] { return str(in[i]) + ": " + str(dir[i].v(0)) + " vs " + str(cDir); });
+    }
+    mUsable.check();
+    dAxis.check();
+    dOmc.check();
+    dInv.check();
+    dPdf.check();
+    dDir.check();
+    // The inputs reach every outcome: points that see casters, refractive casters refused and accepted by
+    // casterFacesLights.
+    if (scene.count.x > 0) CHECK(usableRecords > static_cast<int>(n) / 10);
+    if (scene.count.y != 0) CHECK(refusedByLights > static_cast<int>(n) / 20);
+    if (scene.count.y != 0 && scene.lights.w >= 0.0f) CHECK(acceptedByLights > static_cast<int>(n) / 20);
+    if (reportWanted())
+      MESSAGE(usableRecords, " records see casters; in ", refusedByLights,
+              " casterFacesLights refuses a refractive one, in ", acceptedByLights, " it accepts one");
+  }
+}
