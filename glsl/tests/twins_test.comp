@@ -3,6 +3,7 @@
 // One invocation per record; #version is injected by the host; no feature defines are needed.
 #include "../shared/gpu_layout.h"
 #include "../lib/rng.glsl"
+#include "../lib/spawn.glsl"
 #include "../lib/sampling.glsl"
 #include "../lib/spectral.glsl"
 #include "../lib/materials.glsl"
@@ -22,7 +23,7 @@ layout(location = 1) uniform uint function;  // one of the constants below (enum
 const uint kInWords = 4u;
 const uint kOutWords = 11u;
 
-const uint kPcgHash = 0u;
+const uint kPcg4d = 0u;
 const uint kRngSeed = 1u;
 const uint kRand01 = 2u;
 const uint kLuminance = 3u;
@@ -43,6 +44,7 @@ const uint kCasterFacesLights = 17u;
 const uint kPrepareCasters = 18u;
 const uint kDiffuseDirectionPdf = 19u;
 const uint kSampleDiffuseDirection = 20u;
+const uint kHitPointError = 21u;
 
 uvec4 bits(vec4 v) { return floatBitsToUint(v); }
 uvec4 bits(vec3 v, float w) { return floatBitsToUint(vec4(v, w)); }
@@ -60,16 +62,16 @@ void main() {
   uvec4 o[kOutWords];
   for (uint k = 0u; k < kOutWords; ++k) o[k] = uvec4(0u);
 
-  if (function == kPcgHash) {
-    o[0].x = pcgHash(raw[0].x);
+  if (function == kPcg4d) {
+    o[0] = pcg4d(raw[0]);
   } else if (function == kRngSeed) {
-    o[0].x = rngSeed(raw[0].x, raw[0].y, raw[0].z);
-  } else if (function == kRand01) {  // three draws, then the state
-    uint state = raw[0].x;
+    o[0] = rngSeed(raw[0].x, raw[0].y, raw[0].z);
+  } else if (function == kRand01) {  // three draws from state raw[0], then the state
+    uvec4 state = raw[0];
     o[0].x = floatBitsToUint(rand01(state));
     o[0].y = floatBitsToUint(rand01(state));
     o[0].z = floatBitsToUint(rand01(state));
-    o[0].w = state;
+    o[1] = state;
   } else if (function == kLuminance) {
     o[0].x = floatBitsToUint(luminance(a[0].xyz));
   } else if (function == kOrthonormalBasis) {
@@ -90,8 +92,10 @@ void main() {
     bool ok = refractDir(a[0].xyz, a[1].xyz, a[0].w, t);
     o[0] = bits(t, 0.0);
     o[0].w = bit(ok);
-  } else if (function == kOffsetRayOrigin) {  // a[0].xyz = p, a[1].xyz = n
-    o[0] = bits(offsetRayOrigin(a[0].xyz, a[1].xyz), 0.0);
+  } else if (function == kOffsetRayOrigin) {  // a[0].xyz = p, a[1].xyz = n, a[2].xyz = pError
+    o[0] = bits(offsetRayOrigin(a[0].xyz, a[2].xyz, a[1].xyz), 0.0);
+  } else if (function == kHitPointError) {  // a[0].xyz = (b0, b1, b2), a[1..3].xyz = p0, p1, p2
+    o[0] = bits(hitPointError(a[0].x, a[0].y, a[0].z, a[1].xyz, a[2].xyz, a[3].xyz), 0.0);
   } else if (function == kSampleDielectric) {  // a[0] = (d, eta), a[1] = (n, u)
     vec3 wi;
     bool transmitted;

@@ -17,6 +17,7 @@
 
 #include "gpu/gl_objects.h"
 #include "gpu/shader_library.h"
+#include "accel/spawn.h"
 #include "shading/sampling.h"
 
 using namespace caustica;
@@ -25,10 +26,10 @@ namespace {
 
 // Function numbers of twins_test.comp, in its order.
 enum class Fn : GLuint {
-  PcgHash, RngSeed, Rand01, Luminance, OrthonormalBasis, SampleCosineHemisphere, SampleTriangleUniform,
+  Pcg4d, RngSeed, Rand01, Luminance, OrthonormalBasis, SampleCosineHemisphere, SampleTriangleUniform,
   PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
   ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
-  DiffuseDirectionPdf, SampleDiffuseDirection
+  DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError
 };
 
 constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
@@ -261,33 +262,30 @@ const float kEtas[] = {1.5f, 1.0f / 1.5f, 1.33f, 1.0f / 1.33f, 2.4f, 1.0f / 2.4f
 
 }  // namespace
 
-TEST_CASE("GLSL rng functions equal their C++ twins bit for bit: pcgHash, rngSeed, rand01") {
+TEST_CASE("GLSL rng functions equal their C++ twins bit for bit: pcg4d, rngSeed, rand01") {
   GlslTwins gpu;
   Random r(1);
   std::vector<In> in;
-  for (std::uint32_t v : {0u, 1u, 0x7fffffffu, 0x80000000u, 0xffffffffu}) in.push_back(uints({v, v, v, 0}));
-  // rand01's first draw is (pcgHash(state) >> 8) / 2^24: states giving exactly 0 and 1 - 2^-24.
-  for (std::uint32_t want : {0u, 0xffffffu}) {
-    std::uint32_t v = 0;
-    while ((pcgHash(v) >> 8u) != want) ++v;
-    in.push_back(uints({v, 0, 0, 0}));
-  }
-  for (std::uint32_t i = 0; i < 1024; ++i) in.push_back(uints({i, i & 7u, 1u, 0}));
-  while (in.size() < 8192) in.push_back(uints({r.g(), r.g(), r.g(), 0}));
+  for (std::uint32_t v : {0u, 1u, 0x7fffffffu, 0x80000000u, 0xffffffffu}) in.push_back(uints({v, v, v, v}));
+  in.push_back(uints({0, 0, 0, 0}));  // rngSeed's guarded key region and a zero xoshiro word
+  for (std::uint32_t i = 0; i < 1024; ++i) in.push_back(uints({i, i & 7u, 1u, 0x9E3779B9u}));
+  while (in.size() < 8192) in.push_back(uints({r.g(), r.g(), r.g(), r.g()}));
 
   // Integer arithmetic, and float(24-bit integer) * 2^-24, are exact on both sides: every bit must agree.
-  std::vector<Out> hash = gpu.run(Fn::PcgHash, in), seed = gpu.run(Fn::RngSeed, in), draws = gpu.run(Fn::Rand01, in);
-  Mismatches mHash("pcgHash"), mSeed("rngSeed"), mRand("rand01 (three draws, then the state)");
+  std::vector<Out> hash = gpu.run(Fn::Pcg4d, in), seed = gpu.run(Fn::RngSeed, in), draws = gpu.run(Fn::Rand01, in);
+  Mismatches mHash("pcg4d"), mSeed("rngSeed"), mRand("rand01 (three draws, then the state)");
   for (size_t i = 0; i < in.size(); ++i) {
     glm::uvec4 a = in[i].w[0];
-    std::uint32_t h = pcgHash(a.x), s = rngSeed(a.x, a.y, a.z);
-    auto args = [&] { return "uints " + std::to_string(a.x) + " " + std::to_string(a.y) + " " + std::to_string(a.z); };
-    mHash.add(hash[i].w[0].x == h, args);
-    mSeed.add(seed[i].w[0].x == s, args);
-    std::uint32_t state = a.x;
+    auto args = [&] {
+      return "uints " + std::to_string(a.x) + " " + std::to_string(a.y) + " " + std::to_string(a.z) + " " +
+             std::to_string(a.w);
+    };
+    mHash.add(hash[i].w[0] == pcg4d(a), args);
+    mSeed.add(seed[i].w[0] == rngSeed(a.x, a.y, a.z), args);
+    RngState state = a;
     float u0 = rand01(state), u1 = rand01(state), u2 = rand01(state);
-    glm::uvec4 want(sameBits<std::uint32_t>(u0), sameBits<std::uint32_t>(u1), sameBits<std::uint32_t>(u2), state);
-    mRand.add(draws[i].w[0] == want, args);
+    glm::uvec3 want(sameBits<std::uint32_t>(u0), sameBits<std::uint32_t>(u1), sameBits<std::uint32_t>(u2));
+    mRand.add(glm::uvec3(draws[i].w[0]) == want && draws[i].w[1] == state, args);
   }
   mHash.check();
   mSeed.check();
@@ -452,28 +450,52 @@ TEST_CASE("GLSL Fresnel, refraction, ray offset and dielectric sampling equal th
   dDiel.check();
   dDielF.check();
 
-  // offsetRayOrigin: both branches (|p| below and above 1/32) and their border, signs, zeros, large p,
-  // normals whose 256 n truncates to 0 in some components. Integer steps on the float bits, and
-  // p + 2^-16 n (an exact product, one rounded sum), are exact on both sides: every bit must agree.
+  // hitPointError and offsetRayOrigin (spawn.glsl): points near 0, near the float limits of a scene
+  // (1e-8 .. 1e8), zero errors, normals along axes. GLSL may fuse the multiply-adds, so results may
+  // differ by a rounding: within 4 ULP of the largest term (the bound itself has slack of 7 ULPs).
+  std::vector<In> errs;
+  while (errs.size() < n) {
+    float b1 = r.uniform(), b2 = r.uniform() * (1.0f - b1);
+    float scale = r.logUniform(1e-8f, 1e8f);
+    glm::vec3 c = r.inBox(1.0f) * r.logUniform(1e-8f, 1e8f);
+    errs.push_back(floats(glm::vec4(1.0f - b1 - b2, b1, b2, 0), glm::vec4(c + scale * r.inBox(1.0f), 0),
+                          glm::vec4(c + scale * r.inBox(1.0f), 0), glm::vec4(c + scale * r.inBox(1.0f), 0)));
+  }
+  std::vector<Out> err = gpu.run(Fn::HitPointError, errs);
+  MaxDiff dErr("hitPointError (relative)", 4 * kEps);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec4 b = arg(errs[i], 0);
+    glm::vec3 c = hitPointError(b.x, b.y, b.z, glm::vec3(arg(errs[i], 1)), glm::vec3(arg(errs[i], 2)),
+                                glm::vec3(arg(errs[i], 3)));
+    for (int k = 0; k < 3; ++k)
+      dErr.add(std::abs(double(err[i].f(0, k)) - c[k]) / std::max(double(c[k]), 1e-38),
+               [&] { return str(errs[i]) + ": " + str(err[i].v(0)) + " vs " + str(c); });
+  }
+  dErr.check();
+
   std::vector<In> offs;
-  const float kBorder = 1.0f / 32.0f;
-  const float edges[] = {
-      0.0f,  -0.0f, kBorder, -kBorder, std::nextafter(kBorder, 0.0f), -std::nextafter(kBorder, 0.0f), 1.0f,
-      -1.0f, 1e4f,  -1e4f,   1e-6f};
-  for (float e : edges)
+  for (float e : {0.0f, -0.0f, 1.0f, -1.0f, 1e4f, -1e4f, 1e-6f})
     for (const glm::vec3& nn : {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::normalize(glm::vec3(1, -2, 3)),
                                 glm::normalize(glm::vec3(1e-3f, -1e-3f, 1))})
-      offs.push_back(floats(glm::vec4(e, -e, e, 0), glm::vec4(nn, 0)));
-  while (offs.size() < n)
-    offs.push_back(floats(glm::vec4(r.inBox(1.0f) * r.logUniform(1e-4f, 1e4f), 0), glm::vec4(r.unit(), 0)));
-  std::vector<Out> off = gpu.run(Fn::OffsetRayOrigin, offs);
-  Mismatches mOff("offsetRayOrigin (bit for bit)");
-  for (size_t i = 0; i < n; ++i) {
-    glm::vec3 c = offsetRayOrigin(glm::vec3(arg(offs[i], 0)), glm::vec3(arg(offs[i], 1)));
-    mOff.add(glm::uvec3(off[i].w[0]) == sameBits<glm::uvec3>(c),
-             [&] { return str(offs[i]) + ": " + str(off[i].v(0)) + " vs " + str(c); });
+      offs.push_back(floats(glm::vec4(e, -e, e, 0), glm::vec4(nn, 0), glm::vec4(glm::vec3(std::abs(e) * 4e-7f), 0)));
+  while (offs.size() < n) {
+    glm::vec3 p = r.inBox(1.0f) * r.logUniform(1e-8f, 1e8f);
+    offs.push_back(floats(glm::vec4(p, 0), glm::vec4(r.unit(), 0), glm::vec4(glm::abs(p) * r.logUniform(1e-7f, 1e-5f), 0)));
   }
-  mOff.check();
+  std::vector<Out> off = gpu.run(Fn::OffsetRayOrigin, offs);
+  MaxDiff dOff("offsetRayOrigin (in ULPs of the coordinate)", 4.0);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 p(arg(offs[i], 0)), nn(arg(offs[i], 1)), pe(arg(offs[i], 2));
+    glm::vec3 c = offsetRayOrigin(p, pe, nn);
+    for (int k = 0; k < 3; ++k) {
+      float g = off[i].f(0, k);
+      double ulp = std::max(double(std::nextafter(std::abs(c[k]), 1e38f) - std::abs(c[k])), 1e-45);
+      dOff.add(std::abs(double(g) - c[k]) / ulp, [&] { return str(offs[i]) + ": " + str(off[i].v(0)) + " vs " + str(c); });
+      // Whatever the rounding, both sides move the coordinate the way the normal points.
+      if (nn[k] * pe[k] != 0.0f) CHECK((nn[k] > 0.0f ? g > p[k] : g < p[k]));
+    }
+  }
+  dOff.check();
 }
 
 TEST_CASE("GLSL spectral functions equal their C++ twins: cauchyIor, channelSensitivity") {
