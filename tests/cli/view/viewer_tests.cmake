@@ -1,6 +1,7 @@
-# viewer_tests.cmake — tests of `caustica view`: its camera math (no GL), and the window itself run
-# under Xvfb (Debian packages xvfb and xauth; Mesa llvmpipe draws). Included by tests/CMakeLists.txt.
-# The camera math unit tests (camera_controller_test.cpp) are built into cli_tests by tests/CMakeLists.txt.
+# viewer_tests.cmake — tests of `caustica view`: its camera math and time model (no GL), and the window
+# itself run under Xvfb (Debian packages xvfb and xauth; Mesa llvmpipe draws). Included by
+# tests/CMakeLists.txt, which builds the unit tests (camera_controller_test.cpp, frame_pacer_test.cpp)
+# into cli_tests.
 
 # Compares two linear images within float rounding (and insists they are not black).
 add_executable(viewer_image_compare ${CMAKE_CURRENT_LIST_DIR}/image_compare.cpp)
