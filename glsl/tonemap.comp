@@ -1,5 +1,5 @@
 // tonemap.comp — turns the accumulated radiance sum into the 8-bit sRGB display image (viewer).
-// Same curves as app/core/tonemap.cpp (tonemapCurve); PNG output uses the C++ twin.
+// Same curves as app/image/tonemap.cpp (tonemapCurve); PNG output uses the C++ twin.
 #include "shared/gpu_layout.h"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;

@@ -1,5 +1,5 @@
 // casters.glsl — diffuse bounce directions aimed at caustic casters (bounding spheres of glass and
-// mirror objects, CasterParams in gpu_layout.h) mixed with cosine sampling. Twins in app/core/sampling.h.
+// mirror objects, CasterParams in gpu_layout.h) mixed with cosine sampling. Twins in app/shading/sampling.h.
 // Directions are world-space unit vectors; pdfs are per steradian.
 
 layout(std140, binding = CAUSTICA_BINDING_CASTERS) uniform CasterBlock { CasterParams casters; };

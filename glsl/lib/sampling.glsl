@@ -1,5 +1,5 @@
 // sampling.glsl — sampling routines and small geometry helpers. Each has a C++ twin of the same
-// name in app/core/sampling.h, used by the tests (chi-square and moment tests).
+// name in app/shading/sampling.h, used by the tests (chi-square and moment tests).
 
 const float PI = 3.14159265358979323846;
 const float INV_PI = 0.31830988618379067154;

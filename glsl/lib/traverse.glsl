@@ -1,5 +1,5 @@
 // traverse.glsl — closest-hit and any-hit BVH traversal over nodes[] and triGeom[] (bindings.glsl).
-// Twin of traceClosest()/traceOccluded() in app/core/bvh.cpp. Include bindings.glsl and intersect.glsl first.
+// Twin of traceClosest()/traceOccluded() in app/accel/bvh.cpp. Include bindings.glsl, spawn.glsl and intersect.glsl first.
 //
 // Packing relied on (glsl/shared/gpu_layout.h, built by buildBvh/packTriGeom):
 //   BvhNode (32 bytes): bmin, bmax = world-space box; triCount == 0: inner node whose children are

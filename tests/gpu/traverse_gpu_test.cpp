@@ -1,4 +1,4 @@
-// traverse_gpu_test.cpp — the GLSL BVH traversal (trace_test.comp on llvmpipe) returns the same
+// traverse_gpu_test.cpp — the GLSL BVH traversal (glsl/tests/trace_test.comp on llvmpipe) returns the same
 // hits as its C++ twin, ray for ray, on the bunny, a Cornell box and a random soup.
 #include <doctest/doctest.h>
 
@@ -58,8 +58,8 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
   GlBuffer hitBuf = GlBuffer::create(sizeof(glm::vec4) * rayCount, nullptr);
   GlBuffer occBuf = GlBuffer::create(sizeof(std::uint32_t) * rayCount, nullptr);
   ShaderLibrary lib;
-  ExpandedShader src = lib.expand("trace_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "trace_test.comp");
+  ExpandedShader src = lib.expand("tests/trace_test.comp", {});
+  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
   prog.use();
   nodes.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_NODES);
   geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);

@@ -1,9 +1,9 @@
-#include "lib/bindings.glsl"
-#include "lib/spawn.glsl"
-#include "lib/intersect.glsl"
-#include "lib/traverse.glsl"
 // trace_test.comp — GPU test entry: traces a batch of rays with traceClosest and traceOccluded so a
 // host test can compare them with the C++ twins. One invocation per ray; #version is injected by the host.
+#include "../lib/bindings.glsl"
+#include "../lib/spawn.glsl"
+#include "../lib/intersect.glsl"
+#include "../lib/traverse.glsl"
 
 layout(local_size_x = 64) in;
 
