@@ -234,8 +234,8 @@ void main() {
     vec3 l = tracePath(pixel, rng);
     primary = 1u;
     bool finite = !(any(isnan(l)) || any(isinf(l)));
-    if (!finite) bad = 1u;  // never added to the image; counted
-    accumulate(ivec2(pixel), finite ? l : vec3(0.0), 1.0);
+    if (!finite) bad = 1u;  // counted and reported; not part of the pixel's mean (neither as black)
+    accumulate(ivec2(pixel), finite ? l : vec3(0.0), finite ? 1.0 : 0.0);
   }
   atomicAdd(groupCounts[0], primary);
   atomicAdd(groupCounts[1], gSecondaryRays);
