@@ -111,11 +111,19 @@ vec3 tracePath(uvec2 pixel, inout uint rng) {
         float cosLight = -dot(ls.n, wl);
         float cosSurf = dot(ns, wl);
         if ((cosLight > 0.0 || (ls.twoSided && cosLight < 0.0)) && cosSurf > 0.0 && dot(ng, wl) > 0.0 && dist > 0.0) {
+          vec3 nLight = cosLight > 0.0 ? ls.n : -ls.n;  // the emitter's geometric normal on p's side
           cosLight = abs(cosLight);
           float pdfLight = ls.pdfArea * dist2 / cosLight;
           ++gShadowRays;
-          // Stop just short of the light so its own triangle (and coplanar neighbours) do not occlude.
-          if (!traceOccluded(offsetRayOrigin(p, ng), wl, dist * (1.0 - 1.0e-4))) {
+          // The shadow ray joins two points each moved off its own surface (pbrt-v4's SpawnRayTo): p
+          // along ng, the light point along nLight. Both ends, and so the whole segment, lie strictly
+          // on the lit side of the light's triangle, which therefore cannot occlude its own sample at
+          // any angle. (Reusing wl and dist from the unmoved p shifted the ray's end by p's offset,
+          // up to ~1e-4 scene units, behind the emitter whenever ng and nLight point alike: at grazing
+          // angles or short range the ray hit the sampled triangle, and curved lights came out dark.)
+          vec3 from = offsetRayOrigin(p, ng);
+          vec3 to = offsetRayOrigin(ls.p, nLight);
+          if (!traceOccluded(from, to - from, 1.0 - 1.0e-4)) {
 #ifdef CAUSTICA_CASTERS
             float pdfBsdf = diffuseDirectionPdf(ns, wl);
 #else
