@@ -113,13 +113,18 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
         float cosLight = -dot(ls.n, wl);
         float cosSurf = dot(ns, wl);
         if ((cosLight > 0.0 || (ls.twoSided && cosLight < 0.0)) && cosSurf > 0.0 && dot(ng, wl) > 0.0 && dist > 0.0) {
+          vec3 nLight = cosLight > 0.0 ? ls.n : -ls.n;  // the emitter's geometric normal on p's side
           cosLight = abs(cosLight);
           float pdfLight = ls.pdfArea * dist2 / cosLight;
           ++gShadowRays;
-          // Both ends leave their surfaces past their error bounds (spawn.glsl), and the ray stops just
-          // short of the light's offset point, so neither surface can occlude it at any scale.
+          // The shadow ray joins two points each moved off its own surface past its error bound
+          // (spawn.glsl; pbrt-v4's SpawnRayTo): p along ng, the light point along its normal on p's
+          // side. The whole segment lies strictly on the lit side of the light's triangle, which
+          // therefore cannot occlude its own sample at any angle, distance or scale. (Reusing wl and
+          // dist from the unmoved p shifted the ray's end behind the emitter whenever ng and the
+          // light's normal point alike: curved lights came out dark, 3-10 %.)
           vec3 from = offsetRayOrigin(p, pError, ng);
-          vec3 to = offsetRayOrigin(ls.p, ls.pError, dot(ls.n, wl) < 0.0 ? ls.n : -ls.n);  // towards p
+          vec3 to = offsetRayOrigin(ls.p, ls.pError, nLight);
           vec3 seg = to - from;
           float segLen = length(seg);
           if (segLen > 0.0 && !traceOccluded(from, seg / segLen, segLen * (1.0 - 1.0e-4))) {

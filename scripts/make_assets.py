@@ -248,6 +248,83 @@ def prism(side, length):
     return mesh
 
 
+def torus_knot_tube(p, q, big_r, small_r, radius, segments, sides):
+    """Closed tube of circular cross-section `radius` around the (p, q) torus knot
+    ((big_r + small_r cos qt) cos pt, small_r sin qt, (big_r + small_r cos qt) sin pt), t in [0, 2 pi):
+    the knot lies flat (y up). Smooth per-vertex normals (the tube's radial directions), fronts
+    outward, rings joined end to start through shared vertices, so the surface is closed. Frames are
+    parallel-transported along the curve and the leftover twist is spread evenly, so the last ring
+    meets the first exactly. Returns (mesh, area of its triangles)."""
+    def centre(t):
+        rr = big_r + small_r * math.cos(q * t)
+        return (rr * math.cos(p * t), small_r * math.sin(q * t), rr * math.sin(p * t))
+
+    ts = [2.0 * math.pi * i / segments for i in range(segments)]
+    pts = [centre(t) for t in ts]
+    tangents = [normalize(sub(pts[(i + 1) % segments], pts[i - 1])) for i in range(segments)]
+    # Parallel transport: project the previous normal onto the plane of the next tangent.
+    frames = []
+    n = normalize(cross(tangents[0], (0.0, 1.0, 0.0)))
+    for i in range(segments + 1):
+        t = tangents[i % segments]
+        n = normalize(sub(n, scale(t, dot(n, t))))
+        frames.append(n)
+    # Twist left over after one loop (angle of the transported normal against the first one).
+    t0, n0, b0 = tangents[0], frames[0], cross(tangents[0], frames[0])
+    twist = math.atan2(dot(frames[segments], b0), dot(frames[segments], n0))
+    mesh = MeshData()
+    rings = []
+    for i in range(segments):
+        t = tangents[i]
+        nrm = frames[i]
+        bin_ = cross(t, nrm)
+        ring = []
+        for j in range(sides):
+            a = 2.0 * math.pi * j / sides - twist * i / segments
+            d = add(scale(nrm, math.cos(a)), scale(bin_, math.sin(a)))
+            ring.append(mesh.vertex(add(pts[i], scale(d, radius)), d))
+        rings.append(ring)
+    area = 0.0
+    for i in range(segments):
+        r0, r1 = rings[i], rings[(i + 1) % segments]
+        for j in range(sides):
+            k = (j + 1) % sides
+            for tri in ((r0[j], r1[j], r1[k]), (r0[j], r1[k], r0[k])):
+                a, b, c = (mesh.positions[v] for v in tri)
+                nrm = cross(sub(b, a), sub(c, a))
+                if dot(nrm, mesh.normals[tri[0]]) < 0.0:  # front face outward
+                    tri = (tri[0], tri[2], tri[1])
+                mesh.indices += list(tri)
+                area += 0.5 * math.sqrt(dot(nrm, nrm))
+    return mesh, area
+
+
+def wavy_sheet(width, depth, amplitude, waves, segments, rows):
+    """Open curved sheet (no thickness) y = amplitude * sin(waves * 2 pi x / width) over
+    x in [-width/2, width/2], z in [-depth/2, depth/2], smooth normals; front faces point down
+    (-y side), so it is a non-convex, open emitter. Returns (mesh, area of its triangles)."""
+    k = waves * 2.0 * math.pi / width
+    mesh = MeshData()
+    grid = []
+    for i in range(segments + 1):
+        x = -width / 2.0 + width * i / segments
+        y = amplitude * math.sin(k * x)
+        n = normalize((amplitude * k * math.cos(k * x), -1.0, 0.0))  # downward normal of the curve
+        grid.append([mesh.vertex((x, y, -depth / 2.0 + depth * j / rows), n) for j in range(rows + 1)])
+    area = 0.0
+    for i in range(segments):
+        for j in range(rows):
+            a, b, c, d = grid[i][j], grid[i + 1][j], grid[i + 1][j + 1], grid[i][j + 1]
+            for tri in ((a, b, c), (a, c, d)):
+                pa, pb, pc = (mesh.positions[v] for v in tri)
+                nrm = cross(sub(pb, pa), sub(pc, pa))
+                if dot(nrm, mesh.normals[tri[0]]) < 0.0:
+                    tri = (tri[0], tri[2], tri[1])
+                mesh.indices += list(tri)
+                area += 0.5 * math.sqrt(dot(nrm, nrm))
+    return mesh, area
+
+
 def bunny(height):
     """The Stanford bunny from BUNNY_OBJ, scaled to `height`, base centred at the origin, with
     area-weighted smooth normals."""
@@ -553,6 +630,59 @@ def cornell_dispersion():
     return g.finish()
 
 
+def classic_light_luminance_power():
+    """luminance(17, 12, 4) x 0.47 m x 0.38 m: the classic ceiling light's (one-sided) power weight."""
+    return (0.2126 * 17.0 + 0.7152 * 12.0 + 0.0722 * 4.0) * 0.47 * 0.38
+
+
+def cornell_tube_light():
+    """Cornell box lit only by a closed, smooth-shaded, non-convex emitter: a tube of radius 5 cm
+    around a (2, 3) torus knot hanging under the ceiling (one-sided, fronts outward), with a glass
+    sphere on the floor. Test scene for light sampling from curved emitters (naive vs mis)."""
+    g = Gltf()
+    add_cornell_box(g)
+    mesh, area = torus_knot_tube(2, 3, 0.32, 0.12, 0.05, 160, 10)
+    color = (1.0, 0.9, 0.75)
+    lum = 0.2126 * color[0] + 0.7152 * color[1] + 0.0722 * color[2]
+    strength = round(classic_light_luminance_power() / (area * lum), 3)
+    emitter = g.material("tube light", color=(0.78, 0.78, 0.78), emissive=color, strength=strength)
+    g.object("tube light", mesh, emitter, translation=(0.0, 1.62, -0.1))
+    radius = 0.3
+    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
+                       thickness=2 * radius)
+    g.object("glass sphere", uv_sphere(radius, 32, 16), glass, translation=(0.3, radius, 0.25))
+    g.camera("camera", **CORNELL_CAMERA)
+    doc = g.finish()
+    doc["asset"]["extras"] = {"description": "Test scene: Cornell box lit only by a closed, smooth-shaded "
+                              "torus-knot tube light (naive vs mis light-sampling test).",
+                              "tubeArea_m2": clean(area, 4)}
+    return doc
+
+
+def cornell_sheet_light():
+    """Cornell box lit only by an open, double-sided, smooth-shaded wavy sheet under the ceiling,
+    with a glass sphere on the floor: the thin-shell counterpart of cornell_tube_light."""
+    g = Gltf()
+    add_cornell_box(g)
+    mesh, area = wavy_sheet(0.9, 0.5, 0.08, 1.5, 48, 6)
+    color = (1.0, 0.9, 0.75)
+    lum = 0.2126 * color[0] + 0.7152 * color[1] + 0.0722 * color[2]
+    strength = round(classic_light_luminance_power() / (2.0 * area * lum), 3)
+    emitter = g.material("sheet light", color=(0.78, 0.78, 0.78), emissive=color, strength=strength,
+                         double_sided=True)
+    g.object("sheet light", mesh, emitter, translation=(0.0, 1.7, -0.1))
+    radius = 0.3
+    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
+                       thickness=2 * radius)
+    g.object("glass sphere", uv_sphere(radius, 32, 16), glass, translation=(0.3, radius, 0.25))
+    g.camera("camera", **CORNELL_CAMERA)
+    doc = g.finish()
+    doc["asset"]["extras"] = {"description": "Test scene: Cornell box lit only by an open, double-sided, "
+                              "smooth-shaded wavy sheet light (naive vs mis light-sampling test).",
+                              "sheetArea_m2": clean(area, 4)}
+    return doc
+
+
 def furnace(glass=False, albedo=0.5):
     """Closed cube room, every wall a Lambertian emitter (radiance 1, albedo `albedo`), camera inside.
     Exact radiance everywhere: 1 / (1 - albedo)."""
@@ -732,6 +862,8 @@ def main():
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),
         os.path.join(TEST_SCENES, "small-cornell.gltf"): small_cornell(),
+        os.path.join(TEST_SCENES, "tube-light.gltf"): cornell_tube_light(),
+        os.path.join(TEST_SCENES, "sheet-light.gltf"): cornell_sheet_light(),
     }
     for path, doc in scenes.items():
         write_json(path, doc)
