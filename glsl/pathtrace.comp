@@ -22,6 +22,7 @@ layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y)
 shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samples
 
 uint gSecondaryRays = 0u;
+const uint kMaxPassThroughs = 256u;  // alpha pass-throughs a path may make beyond its bounces
 uint gShadowRays = 0u;
 
 // One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
@@ -39,8 +40,9 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   uint maxDepth = frame.options.x;
   bool firstDiffuse = true;  // no diffuse vertex yet on this path
 
+  uint passThroughs = 0u;  // alpha pass-throughs: not bounces, so they do not consume the depth cap
   for (uint depth = 0u; depth < maxDepth; ++depth) {
-    if (depth > 0u) ++gSecondaryRays;
+    if (depth + passThroughs > 0u) ++gSecondaryRays;
     Hit hit;
     if (!traceClosest(org, dir, 3.0e38, hit)) break;
 #ifdef CAUSTICA_VOLUME
@@ -82,6 +84,10 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     if (base.a < 1.0 && rand01(rng) >= base.a) {  // pass straight through (a delta event)
       org = offsetRayOrigin(p, pError, -ng);
       prevDelta = true;
+      if (passThroughs < kMaxPassThroughs) {  // up to that many layers of cut-outs are free
+        ++passThroughs;
+        --depth;  // uint: wraps to the maximum at depth 0, and the loop's ++depth brings it back
+      }
       continue;
     }
 #endif

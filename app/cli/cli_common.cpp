@@ -110,7 +110,7 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--seed", "", "S", "random seed (default 1); the same seed gives the same image"},
       {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
       {"--dispersion", "", "MODE", "rgb (one channel per path; default) or spectral (hero wavelength)"},
-      {"--max-depth", "", "N", "maximum path length in bounces (default 32)"},
+      {"--max-depth", "", "N", "maximum path length in bounces, a safety cap: Russian roulette ends paths (default 256)"},
       {"--caster-probability", "", "P",
        "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},

@@ -21,7 +21,10 @@ constexpr int kMaxImageSide = 16384;              // pixels; the GPU's texture l
 struct RenderSettings {
   int width = 512, height = 512;  // pixels
   std::uint32_t seed = 1;
-  int maxDepth = 32;              // path segments, kMinMaxDepth..kMaxMaxDepth
+  // Path segments, kMinMaxDepth..kMaxMaxDepth: a safety cap; Russian roulette ends paths long
+  // before it in ordinary scenes (docs/stability.md), so it biases only paths trapped for hundreds
+  // of bounces (total internal reflection, white furnaces).
+  int maxDepth = 256;
   Integrator integrator = Integrator::Mis;
   DispersionMode dispersion = DispersionMode::Rgb;
   // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)

@@ -78,6 +78,7 @@ TEST_CASE("the cache key text and stem match an entry cached before the bench wa
   key.settings = referenceSettings(RenderSettings{}, DispersionMode::Rgb);
   key.settings.width = 16;
   key.settings.height = 16;
+  key.settings.maxDepth = 32;  // the default when that entry was written
   key.spp = 8;
   key.cameraIndex = 0;
   key.camera.position = {0.0f, 1.0f, 3.7f};
