@@ -1,0 +1,32 @@
+# fuzz_inputs.cmake — every input the fuzzer found (DIR = tests/data/fuzz, see docs/fuzzing.md) must
+# make `caustica info` either load the scene (exit status 0) or fail cleanly (exit status 1 with a
+# one-line error naming the file): never a crash, a signal, an internal error or a hang.
+# Passes on an empty folder, and says so.
+file(GLOB inputs LIST_DIRECTORIES false ${DIR}/*)
+set(count 0)
+set(loaded 0)
+foreach(f ${inputs})
+  get_filename_component(ext ${f} EXT)
+  if(ext STREQUAL ".md")
+    continue()  # the folder's README
+  endif()
+  get_filename_component(name ${f} NAME)
+  execute_process(COMMAND ${CLI} info ${f} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 60)
+  if(rc EQUAL 0)
+    math(EXPR loaded "${loaded} + 1")
+  elseif(rc EQUAL 1)
+    string(FIND "${err}" "${name}" named)
+    if(named EQUAL -1)
+      message(FATAL_ERROR "info ${name}: the error does not name the file: ${err}")
+    endif()
+  else()
+    message(FATAL_ERROR "info ${name}: expected exit status 0 or 1, got '${rc}'\n${err}")
+  endif()
+  math(EXPR count "${count} + 1")
+endforeach()
+if(count EQUAL 0)
+  message(STATUS "no fuzzer-found inputs in ${DIR} yet: nothing to check")
+else()
+  math(EXPR failed "${count} - ${loaded}")
+  message(STATUS "${count} fuzzer-found inputs: ${loaded} load, ${failed} fail cleanly")
+endif()
