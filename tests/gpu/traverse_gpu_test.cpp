@@ -2,6 +2,8 @@
 // hits as its C++ twin, ray for ray, on the bunny, a Cornell box and a random soup.
 #include <doctest/doctest.h>
 
+#include <array>
+#include <cmath>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -28,6 +30,35 @@ std::vector<Triangle> randomSoup(int n, std::mt19937& g) {
   return tris;
 }
 
+// Traces rays (two vec4 each: origin and tmax, direction) with glsl/tests/trace_test.comp: per ray
+// (t, u, v, tri bits) of traceClosest and 1/0 of traceOccluded.
+void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std::vector<glm::vec4>& rays,
+                std::vector<glm::vec4>& hits, std::vector<std::uint32_t>& occ) {
+  const int rayCount = static_cast<int>(rays.size() / 2);
+  GlBuffer nodes = GlBuffer::fromVector(bvh.nodes);
+  GlBuffer geomBuf = GlBuffer::fromVector(geom);
+  GlBuffer rayBuf = GlBuffer::fromVector(rays);
+  GlBuffer hitBuf = GlBuffer::create(sizeof(glm::vec4) * rayCount, nullptr);
+  GlBuffer occBuf = GlBuffer::create(sizeof(std::uint32_t) * rayCount, nullptr);
+  static ShaderLibrary lib;
+  ExpandedShader src = lib.expand("tests/trace_test.comp", {});
+  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
+  prog.use();
+  nodes.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_NODES);
+  geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);
+  rayBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 8);
+  hitBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 9);
+  occBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 10);
+  glUniform1ui(0, static_cast<GLuint>(rayCount));
+  glDispatchCompute((rayCount + 63) / 64, 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  checkGlError("trace test dispatch");
+  hits.assign(rayCount, glm::vec4(0.0f));
+  occ.assign(rayCount, 0u);
+  hitBuf.read(0, hits.size() * sizeof(glm::vec4), hits.data());
+  occBuf.read(0, occ.size() * sizeof(std::uint32_t), occ.data());
+}
+
 void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::uint32_t seed) {
   Bvh bvh = buildBvh(tris);
   std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
@@ -52,28 +83,9 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
     cpuRays.push_back(r);
     tmaxes.push_back(tmax);
   }
-  GlBuffer nodes = GlBuffer::fromVector(bvh.nodes);
-  GlBuffer geomBuf = GlBuffer::fromVector(geom);
-  GlBuffer rayBuf = GlBuffer::fromVector(rays);
-  GlBuffer hitBuf = GlBuffer::create(sizeof(glm::vec4) * rayCount, nullptr);
-  GlBuffer occBuf = GlBuffer::create(sizeof(std::uint32_t) * rayCount, nullptr);
-  ShaderLibrary lib;
-  ExpandedShader src = lib.expand("tests/trace_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
-  prog.use();
-  nodes.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_NODES);
-  geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);
-  rayBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 8);
-  hitBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 9);
-  occBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 10);
-  glUniform1ui(0, static_cast<GLuint>(rayCount));
-  glDispatchCompute((rayCount + 63) / 64, 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  checkGlError("trace test dispatch");
-  std::vector<glm::vec4> hits(rayCount);
-  std::vector<std::uint32_t> occ(rayCount);
-  hitBuf.read(0, hits.size() * sizeof(glm::vec4), hits.data());
-  occBuf.read(0, occ.size() * sizeof(std::uint32_t), occ.data());
+  std::vector<glm::vec4> hits;
+  std::vector<std::uint32_t> occ;
+  traceOnGpu(bvh, geom, rays, hits, occ);
 
   int mismatches = 0, hitCount = 0;
   for (int i = 0; i < rayCount; ++i) {
@@ -106,4 +118,64 @@ TEST_CASE("GPU traversal equals the C++ twin: random soup with a degenerate tria
 TEST_CASE("GPU traversal equals the C++ twin: Cornell box scene") {
   Scene s = loadScene(test::sourcePath("assets/scenes/cornell-box.gltf"));
   compareGpuWithTwin(s.triangles, 20000, 3);
+}
+
+TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never escape, on the GPU and in C++") {
+  // A closed mesh with shared, jittered vertices (a UV sphere with poles), rays from random inside
+  // points aimed exactly at vertices, at points on edges, and anywhere. Every ray must hit the mesh:
+  // an escape is a crack between triangles that share an edge (pbrt-v4's Watertight test).
+  std::mt19937 g(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const int rings = 24, segs = 48;
+  std::vector<glm::vec3> v;  // v[0] north pole, then rings - 1 rings of segs, then the south pole
+  v.push_back({0.0f, 1.0f, 0.0f});
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < segs; ++j) {
+      const float th = 3.14159265f * (i + 0.3f * (u(g) - 0.5f)) / rings, ph = 6.2831853f * (j + 0.3f * (u(g) - 0.5f)) / segs;
+      const float r = 1.0f + 0.05f * (u(g) - 0.5f);
+      v.push_back(r * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+    }
+  v.push_back({0.0f, -1.0f, 0.0f});
+  auto at = [&](int i, int j) { return 1 + (i - 1) * segs + (j % segs); };
+  std::vector<std::array<int, 3>> idx;
+  for (int j = 0; j < segs; ++j) idx.push_back({0, at(1, j + 1), at(1, j)});
+  for (int i = 1; i < rings - 1; ++i)
+    for (int j = 0; j < segs; ++j) {
+      idx.push_back({at(i, j), at(i, j + 1), at(i + 1, j + 1)});
+      idx.push_back({at(i, j), at(i + 1, j + 1), at(i + 1, j)});
+    }
+  const int south = static_cast<int>(v.size()) - 1;
+  for (int j = 0; j < segs; ++j) idx.push_back({south, at(rings - 1, j), at(rings - 1, j + 1)});
+  std::vector<Triangle> tris;
+  for (const auto& t : idx) tris.push_back(makeTriangle(v[t[0]], v[t[1]], v[t[2]]));
+  Bvh bvh = buildBvh(tris);
+  std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+
+  const int rayCount = 100000;
+  std::vector<glm::vec4> rays;
+  std::vector<Ray> cpu;
+  for (int k = 0; k < rayCount; ++k) {
+    const glm::vec3 o = 0.9f * std::cbrt(u(g)) * glm::normalize(glm::vec3(u(g) - 0.5f, u(g) - 0.5f, u(g) - 0.5f) + 1e-6f);
+    glm::vec3 target;
+    const auto& t = idx[static_cast<size_t>(u(g) * idx.size()) % idx.size()];
+    if (k % 3 == 0) target = v[t[k % 3 == 0 ? (k / 3) % 3 : 0]];               // a vertex, exactly
+    else if (k % 3 == 1) target = glm::mix(v[t[0]], v[t[1]], u(g));            // a point on an edge
+    else target = 2.0f * glm::normalize(glm::vec3(u(g) - 0.5f, u(g) - 0.5f, u(g) - 0.5f) + 1e-6f);  // anywhere
+    Ray r{o, glm::normalize(target - o)};
+    cpu.push_back(r);
+    rays.push_back(glm::vec4(o, 1e30f));
+    rays.push_back(glm::vec4(r.dir, 0.0f));
+  }
+  std::vector<glm::vec4> hits;
+  std::vector<std::uint32_t> occ;
+  traceOnGpu(bvh, geom, rays, hits, occ);
+  int gpuEscapes = 0, cpuEscapes = 0, gpuOccMisses = 0;
+  for (int k = 0; k < rayCount; ++k) {
+    gpuEscapes += glm::floatBitsToUint(hits[k].w) == gpu::kInvalidIndex;
+    gpuOccMisses += occ[k] == 0u;
+    cpuEscapes += !traceClosest(bvh.nodes, geom, cpu[k], 1e30f).found();
+  }
+  CHECK(gpuEscapes == 0);
+  CHECK(gpuOccMisses == 0);
+  CHECK(cpuEscapes == 0);
 }
