@@ -639,47 +639,40 @@ def cornell_tube_light():
     """Cornell box lit only by a closed, smooth-shaded, non-convex emitter: a tube of radius 5 cm
     around a (2, 3) torus knot hanging under the ceiling (one-sided, fronts outward), with a glass
     sphere on the floor. Test scene for light sampling from curved emitters (naive vs mis)."""
-    g = Gltf()
-    add_cornell_box(g)
     mesh, area = torus_knot_tube(2, 3, 0.32, 0.12, 0.05, 160, 10)
-    color = (1.0, 0.9, 0.75)
-    lum = 0.2126 * color[0] + 0.7152 * color[1] + 0.0722 * color[2]
-    strength = round(classic_light_luminance_power() / (area * lum), 3)
-    emitter = g.material("tube light", color=(0.78, 0.78, 0.78), emissive=color, strength=strength)
-    g.object("tube light", mesh, emitter, translation=(0.0, 1.62, -0.1))
-    radius = 0.3
-    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
-                       thickness=2 * radius)
-    g.object("glass sphere", uv_sphere(radius, 32, 16), glass, translation=(0.3, radius, 0.25))
-    g.camera("camera", **CORNELL_CAMERA)
-    doc = g.finish()
-    doc["asset"]["extras"] = {"description": "Test scene: Cornell box lit only by a closed, smooth-shaded "
-                              "torus-knot tube light (naive vs mis light-sampling test).",
-                              "tubeArea_m2": clean(area, 4)}
-    return doc
+    return curved_light_box("tube light", mesh, area, False, 1.62,
+                            "Test scene: Cornell box lit only by a closed, smooth-shaded torus-knot tube light "
+                            "(naive vs mis light-sampling test).", "tubeArea_m2")
 
 
 def cornell_sheet_light():
     """Cornell box lit only by an open, double-sided, smooth-shaded wavy sheet under the ceiling,
     with a glass sphere on the floor: the thin-shell counterpart of cornell_tube_light."""
+    mesh, area = wavy_sheet(0.9, 0.5, 0.08, 1.5, 48, 6)
+    return curved_light_box("sheet light", mesh, area, True, 1.7,
+                            "Test scene: Cornell box lit only by an open, double-sided, smooth-shaded wavy sheet "
+                            "light (naive vs mis light-sampling test).", "sheetArea_m2")
+
+
+def curved_light_box(name, mesh, area, double_sided, height, description, area_key):
+    """Cornell box lit only by `mesh` (area `area`, one or both sides emitting the classic light's
+    power) hung at `height` under the ceiling, with a glass sphere on the floor."""
     g = Gltf()
     add_cornell_box(g)
-    mesh, area = wavy_sheet(0.9, 0.5, 0.08, 1.5, 48, 6)
     color = (1.0, 0.9, 0.75)
     lum = 0.2126 * color[0] + 0.7152 * color[1] + 0.0722 * color[2]
-    strength = round(classic_light_luminance_power() / (2.0 * area * lum), 3)
-    emitter = g.material("sheet light", color=(0.78, 0.78, 0.78), emissive=color, strength=strength,
-                         double_sided=True)
-    g.object("sheet light", mesh, emitter, translation=(0.0, 1.7, -0.1))
+    sides = 2.0 if double_sided else 1.0
+    strength = round(classic_light_luminance_power() / (sides * area * lum), 3)
+    extra = {"double_sided": True} if double_sided else {}
+    emitter = g.material(name, color=(0.78, 0.78, 0.78), emissive=color, strength=strength, **extra)
+    g.object(name, mesh, emitter, translation=(0.0, height, -0.1))
     radius = 0.3
     glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
                        thickness=2 * radius)
     g.object("glass sphere", uv_sphere(radius, 32, 16), glass, translation=(0.3, radius, 0.25))
     g.camera("camera", **CORNELL_CAMERA)
     doc = g.finish()
-    doc["asset"]["extras"] = {"description": "Test scene: Cornell box lit only by an open, double-sided, "
-                              "smooth-shaded wavy sheet light (naive vs mis light-sampling test).",
-                              "sheetArea_m2": clean(area, 4)}
+    doc["asset"]["extras"] = {"description": description, area_key: clean(area, 4)}
     return doc
 
 
