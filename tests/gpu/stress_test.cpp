@@ -396,3 +396,27 @@ TEST_CASE("stress: long run: 100,000 samples per pixel of a furnace stay exact")
   CHECK(std::abs(mean - 2.0) < 4.0 * sigmaMean + 1e-6);
   for (float v : img.rgb) CHECK(std::abs(v - 2.0f) < 4.0 * sigmaSample / std::sqrt(double(spp)) + 1e-5);
 }
+
+TEST_CASE("stress: coincident and nested dielectric surfaces stay finite, and nested glass in a furnace stays invisible") {
+  // In an enclosure emitting 1, any lossless dielectric arrangement is invisible (radiance 1). Nested
+  // spheres: each interface is traced as air-glass (no stack of media), which keeps that invariant
+  // because every entry has its exit. Coincident spheres (the same triangles twice) have no physical
+  // answer; they must only stay finite.
+  for (bool coincident : {false, true}) {
+    Scene s;
+    s.materials = {diffuse(0.0f, 1.0f), glass()};
+    addInwardBox(s, 2.0f, 0);
+    addSphere(s, glm::vec3(0), 0.6f, 24, 1);
+    addSphere(s, glm::vec3(0), coincident ? 0.6f : 0.3f, 24, 1);
+    finish(s);
+    const Camera cam = lookAt(glm::vec3(0.3f, 0.2f, 1.8f), glm::vec3(0.0f), 0.8f);
+    for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
+      RenderResult r = renderScene(s, cam, settingsFor(24, integ, 1024), 32);
+      INFO(std::string(coincident ? "coincident" : "nested"), " ", std::string(integratorName(integ)));
+      MESSAGE(std::string(coincident ? "coincident" : "nested"), " glass spheres, ", std::string(integratorName(integ)),
+              ": mean ", meanOf(r.image), ", non-finite ", r.stats.nonFinite);
+      CHECK(r.stats.nonFinite == 0);
+      if (!coincident) CHECK(meanOf(r.image) == Rel(1.0, 0.003));
+    }
+  }
+}
