@@ -381,7 +381,9 @@ bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
   const float tt = tScaled * invDet;
   if (!(tt > 0.0f && tt < tmax)) return false;  // also rejects NaN
   // t must be conservatively positive: beyond the bound of its own rounding error (pbrt-v4), so a
-  // ray spawned past a hit point's error box never re-hits the surface it leaves.
+  // ray spawned past a hit point's error box never re-hits the surface it leaves. Like pbrt-v4's,
+  // this bound is right for unit-length directions only (it mixes units of t with world units):
+  // every caller normalises (a short unnormalised shadow ray lost real occluders at 1e-4 scale).
   const float maxZt = std::max(std::fabs(az), std::max(std::fabs(bz), std::fabs(cz)));
   const float maxXt = std::max(std::fabs(ax), std::max(std::fabs(bx), std::fabs(cx)));
   const float maxYt = std::max(std::fabs(ay), std::max(std::fabs(by), std::fabs(cy)));

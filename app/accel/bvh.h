@@ -34,7 +34,7 @@ std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, co
 
 struct Ray {
   glm::vec3 origin{0.0f};
-  glm::vec3 dir{0.0f, 0.0f, 1.0f};  // need not be unit length; t is in units of |dir|
+  glm::vec3 dir{0.0f, 0.0f, 1.0f};  // unit length for a trustworthy hit (intersectTriangle's t bound); t in units of |dir|
 };
 
 struct Hit {

@@ -90,9 +90,17 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
     settings_ = previous;
     throw;
   }
+  if (change.resize) {
+    try {
+      allocateImages();
+    } catch (...) {  // e.g. out of GPU memory: back to the previous settings and images
+      settings_ = previous;
+      allocateImages();
+      throw;
+    }
+  }
   if (change.casters) uploadCasters();
-  if (change.resize) allocateImages();
-  else reset();
+  if (!change.resize) reset();
   return change;
 }
 
@@ -155,9 +163,9 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
   // depend on how samples are split.
   // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
-  // (a sample traces at most 2 * maxDepth + 1 rays).
+  // (a sample traces at most 2 * maxDepth + 1 rays, plus one per alpha pass-through: at most 256).
   const std::uint64_t raysPerDispatch =
-      static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0) * (2u * settings_.maxDepth + 1u);
+      static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0) * (2u * settings_.maxDepth + 1u + 256u);
   const int dispatchesPerRead = static_cast<int>(std::max<std::uint64_t>(1, (1ull << 31) / raysPerDispatch));
   for (int s = 0; s < spp; ++s) {
     if (s > 0 && s % dispatchesPerRead == 0) readCounters();

@@ -52,7 +52,9 @@ bool intersectTriangle(vec3 org, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float tmax
   float tt = tScaled * invDet;
   if (!(tt > 0.0 && tt < tmax)) return false;  // also rejects NaN
   // t must be conservatively positive: beyond the bound of its own rounding error (pbrt-v4), so a
-  // ray spawned past a hit point's error box never re-hits the surface it leaves.
+  // ray spawned past a hit point's error box never re-hits the surface it leaves. Like pbrt-v4's,
+  // this bound is right for unit-length directions only (it mixes units of t with world units):
+  // every caller normalises (a short unnormalised shadow ray lost real occluders at 1e-4 scale).
   float maxZt = max(abs(az), max(abs(bz), abs(cz)));
   float maxXt = max(abs(ax), max(abs(bx), abs(cx)));
   float maxYt = max(abs(ay), max(abs(by), abs(cy)));

@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "accel/bvh.h"
@@ -90,3 +91,4 @@ TEST_CASE("spawn: error bounds scale with the coordinates, and float steps move 
   }
   CHECK(gammaBound(3) == doctest::Approx(3.0 * std::ldexp(1.0, -24)).epsilon(1e-6));
 }
+

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "accel/bvh.h"
+#include "accel/spawn.h"
 #include "scene/obj_mesh.h"
 #include "gpu/gl_objects.h"
 #include "gpu/shader_library.h"
@@ -178,4 +179,60 @@ TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never e
   CHECK(gpuEscapes == 0);
   CHECK(gpuOccMisses == 0);
   CHECK(cpuEscapes == 0);
+}
+
+TEST_CASE("reintersect on the GPU: rays spawned from hits on 1,000 triangles (1e-8..1e8) never hit their own triangle") {
+  // The triangles of tests/accel/spawn_test.cpp's Reintersect test, all in one BVH: from a hit point on
+  // each, 1,000 rays leave through offsetRayOrigin (its GLSL twin is bit-equal, twins_gpu_test) and
+  // the GLSL traversal must never report that triangle (a self-hit has t ~ 0, so nothing can hide it).
+  std::mt19937 g(2024);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f), e(-8.0f, 8.0f);
+  std::normal_distribution<float> nd;
+  auto direction = [&] {
+    for (;;) {
+      glm::vec3 d(nd(g), nd(g), nd(g));
+      if (glm::length(d) > 1e-6f) return glm::normalize(d);
+    }
+  };
+  std::vector<Triangle> tris;
+  std::vector<glm::vec3> points, errors, normals;
+  while (tris.size() < 1000) {
+    const glm::vec3 c = std::pow(10.0f, e(g)) * glm::vec3(u(g), u(g), u(g));
+    const float size = std::pow(10.0f, e(g));
+    Triangle t = makeTriangle(c + size * glm::vec3(u(g), u(g), u(g)), c + size * glm::vec3(u(g), u(g), u(g)),
+                              c + size * glm::vec3(u(g), u(g), u(g)));
+    const glm::dvec3 n = glm::cross(glm::dvec3(t.p[1]) - glm::dvec3(t.p[0]), glm::dvec3(t.p[2]) - glm::dvec3(t.p[0]));
+    if (!(glm::length(n) > 0.0)) continue;
+    const glm::vec3 ng(glm::normalize(n));
+    float b1 = u01(g), b2 = u01(g);
+    if (b1 + b2 > 1.0f) {
+      b1 = 1.0f - b1;
+      b2 = 1.0f - b2;
+    }
+    const float b0 = 1.0f - b1 - b2;
+    tris.push_back(t);
+    points.push_back(b0 * t.p[0] + b1 * t.p[1] + b2 * t.p[2]);
+    errors.push_back(hitPointError(b0, b1, b2, t.p[0], t.p[1], t.p[2]));
+    normals.push_back(ng);
+  }
+  Bvh bvh = buildBvh(tris);
+  std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+  std::vector<std::uint32_t> leafOf(tris.size());  // input index -> index in leaf order
+  for (std::uint32_t i = 0; i < bvh.order.size(); ++i) leafOf[bvh.order[i]] = i;
+  const int perTriangle = 1000;
+  std::vector<glm::vec4> rays;
+  rays.reserve(tris.size() * perTriangle * 2);
+  for (size_t i = 0; i < tris.size(); ++i)
+    for (int k = 0; k < perTriangle; ++k) {
+      const glm::vec3 w = direction();
+      const glm::vec3 n = glm::dot(w, normals[i]) > 0.0f ? normals[i] : -normals[i];
+      rays.push_back(glm::vec4(offsetRayOrigin(points[i], errors[i], n), 3.0e38f));
+      rays.push_back(glm::vec4(w, 0.0f));
+    }
+  std::vector<glm::vec4> hits;
+  std::vector<std::uint32_t> occ;
+  traceOnGpu(bvh, geom, rays, hits, occ);
+  int selfHits = 0;
+  for (size_t r = 0; r < hits.size(); ++r) selfHits += glm::floatBitsToUint(hits[r].w) == leafOf[r / perTriangle];
+  CHECK(selfHits == 0);
 }
