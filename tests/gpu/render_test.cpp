@@ -179,7 +179,7 @@ TEST_CASE("a clear glass sphere inside a uniformly emitting black enclosure is i
 }
 
 TEST_CASE("naive and mis converge to the same image: Cornell box") {
-  checkEstimatorsAgree("assets/scenes/cornell-box.gltf", 32, 32, 256, 64, 32, 40);
+  checkEstimatorsAgree("assets/scenes/cornell-box.gltf", 32, 32, 256, 64, 32, 48);
 }
 
 TEST_CASE("naive and mis converge to the same image at a depth limit of 2: Cornell box") {
