@@ -676,6 +676,16 @@ def curved_light_box(name, mesh, area, double_sided, height, description, area_k
     return doc
 
 
+def far_small_cornell():
+    """small_cornell with its whole node tree (camera included) moved by (1e6, -2e6, 5e5): the loader
+    rebases it in double, and `caustica info` prints that origin (test scene)."""
+    doc = small_cornell()
+    scene = doc["scenes"][doc.get("scene", 0)]
+    doc["nodes"].append({"name": "far away", "translation": [1.0e6, -2.0e6, 5.0e5], "children": scene["nodes"]})
+    scene["nodes"] = [len(doc["nodes"]) - 1]
+    return doc
+
+
 def furnace(glass=False, albedo=0.5):
     """Closed cube room, every wall a Lambertian emitter (radiance 1, albedo `albedo`), camera inside.
     Exact radiance everywhere: 1 / (1 - albedo)."""
@@ -855,6 +865,7 @@ def main():
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),
         os.path.join(TEST_SCENES, "small-cornell.gltf"): small_cornell(),
+        os.path.join(TEST_SCENES, "far-cornell.gltf"): far_small_cornell(),
         os.path.join(TEST_SCENES, "tube-light.gltf"): cornell_tube_light(),
         os.path.join(TEST_SCENES, "sheet-light.gltf"): cornell_sheet_light(),
     }

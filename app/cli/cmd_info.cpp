@@ -56,6 +56,9 @@ int cmdInfo(const std::vector<std::string>& args) {
   for (const auto& [k, n] : kinds) std::printf("            %d x %s\n", n, k.c_str());
   std::printf("textures:   %zu\n", s.textures.size());
   std::printf("bounds:     %s to %s\n", vec(s.bounds.min).c_str(), vec(s.bounds.max).c_str());
+  if (s.origin != glm::dvec3(0.0))  // far from the world origin: positions above are relative to it
+    std::printf("origin:     (%.17g, %.17g, %.17g) (rebased in double; bounds and camera are relative to it)\n",
+                s.origin.x, s.origin.y, s.origin.z);
   const Camera& c = ls.camera;
   std::printf("camera:     %s at %s looking %s, yfov %.1f deg%s (%zu in file)\n",
               s.cameras.empty() ? "automatic" : ("'" + c.name + "'").c_str(), vec(c.position).c_str(),
