@@ -32,9 +32,9 @@ class Renderer {
 
   void setCamera(const Camera& camera);          // restarts accumulation
   // The one place that decides what a settings change needs: new images, another shader variant,
-  // new caster parameters; any change restarts accumulation. Throws Error (and changes nothing) if
-  // `settings` is invalid or too large for this GPU. Returns what it did, so a caller can warm a
-  // new shader variant up.
+  // new caster parameters; any change restarts accumulation. Throws Error if `settings` is invalid
+  // or too large for this GPU, leaving the previous settings in force. Returns what it did, so a
+  // caller can warm a new shader variant up.
   SettingsChange apply(const RenderSettings& settings);
   void reset();
 
