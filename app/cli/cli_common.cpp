@@ -1,7 +1,13 @@
 // cli_common.cpp — option parsing and shared subcommand steps.
 #include "cli/cli_common.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <csignal>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
 
 #include <algorithm>
 #include <chrono>
@@ -144,13 +150,62 @@ void parseSize(const std::string& text, float cameraAspect, int& width, int& hei
   }
 }
 
+namespace {
+volatile std::sig_atomic_t gInterrupt = 0;
+
+extern "C" void onInterrupt(int sig) {
+  gInterrupt = sig;
+  // The first signal asks for a clean stop; the next one ends the program at once.
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+}
+}  // namespace
+
+void installInterruptHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onInterrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART needed: the loop only polls the flag
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+bool interruptRequested() { return gInterrupt != 0; }
+int interruptSignal() { return static_cast<int>(gInterrupt); }
+
+void checkWritableFile(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) throw Error(path + ": cannot write the " + what + ": folder '" + dir.string() + "' does not exist");
+  if (!fs::is_directory(dir, ec)) throw Error(path + ": cannot write the " + what + ": '" + dir.string() + "' is not a folder");
+  if (fs::is_directory(p, ec)) throw Error(path + ": cannot write the " + what + ": it is a folder");
+  if (fs::exists(p, ec) && ::access(path.c_str(), W_OK) != 0)
+    throw Error(path + ": cannot write the " + what + ": " + std::strerror(errno));
+  // Create and remove a file next to it: the only test that covers permissions, read-only mounts
+  // and full quotas alike.
+  std::string probe = (dir / (".caustica-write-test-" + std::to_string(::getpid()))).string();
+  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
+    throw Error(path + ": cannot write the " + what + " in folder '" + dir.string() + "': " + std::strerror(errno));
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
 void renderWithProgress(Renderer& renderer, int targetSpp, const std::string& label, bool quiet) {
+  renderWithProgress(renderer, targetSpp, label, quiet, ProgressHooks{});
+}
+
+bool renderWithProgress(Renderer& renderer, int targetSpp, const std::string& label, bool quiet,
+                        const ProgressHooks& hooks) {
   const auto start = std::chrono::steady_clock::now();
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const bool tty = isatty(STDERR_FILENO) != 0;
   const int first = renderer.samplesPerPixel();
   int batch = 1;
-  double lastPrint = -1.0;
+  double lastPrint = -1.0, lastCheckpoint = 0.0;
+  bool stopped = false;
   while (renderer.samplesPerPixel() < targetSpp) {
     double t0 = seconds();
     renderer.renderPass(std::min(batch, targetSpp - renderer.samplesPerPixel()));
@@ -166,8 +221,18 @@ void renderWithProgress(Renderer& renderer, int targetSpp, const std::string& la
                    label.empty() ? "" : " ", done, targetSpp, now, eta, tty ? "   " : "\n");
       std::fflush(stderr);
     }
+    if (hooks.stopOnInterrupt && interruptRequested()) {
+      stopped = true;
+      break;
+    }
+    if (hooks.checkpointSeconds > 0.0 && hooks.checkpoint && now - lastCheckpoint >= hooks.checkpointSeconds &&
+        done < targetSpp) {
+      hooks.checkpoint();
+      lastCheckpoint = seconds();
+    }
   }
   if (!quiet && tty && renderer.samplesPerPixel() > first) std::fprintf(stderr, "\n");
+  return !stopped;
 }
 
 void note(bool quiet, const std::string& line) {

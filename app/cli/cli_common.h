@@ -1,6 +1,7 @@
 // cli_common.h — the small option parser every subcommand uses, and the steps they share
 // (scene loading, camera choice, image size, context creation).
 #pragma once
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -74,6 +75,28 @@ ShaderLibrary shaderLibraryFrom(const Options& opts);
 // "caustica: LABEL N/M spp" with the elapsed time and an estimate of what is left: in place on a
 // terminal, a line every 10 s in logs.
 void renderWithProgress(Renderer& renderer, int targetSpp, const std::string& label, bool quiet);
+
+// What a long render does besides rendering (render --checkpoint, SIGINT/SIGTERM).
+struct ProgressHooks {
+  double checkpointSeconds = 0.0;   // > 0: call `checkpoint` whenever this much time passed since the last
+  std::function<void()> checkpoint;
+  bool stopOnInterrupt = false;     // stop between passes once interruptRequested()
+};
+// The same, with hooks. Returns false if it stopped early on an interrupt, true once at targetSpp.
+bool renderWithProgress(Renderer& renderer, int targetSpp, const std::string& label, bool quiet,
+                        const ProgressHooks& hooks);
+
+// Exit status of a render that was interrupted (SIGINT/SIGTERM) and wrote its partial image.
+constexpr int kExitInterrupted = 4;
+// Installs SIGINT and SIGTERM handlers (sigaction) that only set a flag; the first signal restores
+// the default handlers, so a second one ends the program at once.
+void installInterruptHandlers();
+bool interruptRequested();
+int interruptSignal();  // the signal that set the flag (0 if none)
+
+// Throws Error naming `path` unless a file can be created there: its folder exists, is a folder and
+// is writable, and `path` itself is not a folder or a read-only file. `what` names it ("output").
+void checkWritableFile(const std::string& path, const std::string& what);
 
 // Prints a line to stderr with the "caustica: " prefix unless quiet.
 void note(bool quiet, const std::string& line);

@@ -3,7 +3,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
+#include "cli/bench/reference_cache.h"
+#include "cli/checkpoint.h"
 #include "cli/cli_common.h"
 #include "cli/commands.h"
 #include "util/error.h"
@@ -18,11 +21,17 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--spp", "", "N", "samples per pixel (default 64)"},
       {"--exposure", "", "STOPS", "PNG exposure in stops (default 0)"},
       {"--tonemap", "", "CURVE", "PNG tone curve: aces (default) or clamp"},
+      {"--checkpoint", "", "SECONDS", "rewrite a checkpoint every SECONDS (atomically) and at the end"},
+      {"--checkpoint-file", "", "FILE", "where checkpoints go (default OUTPUT.ckpt)"},
+      {"--resume", "", "CHECKPOINT",
+       "continue the render saved in CHECKPOINT (same scene and settings; --spp is the new total)"},
   };
   for (auto& s : sceneOptionSpecs()) specs.push_back(s);
   Options opts("caustica render [SCENE] [options]",
                "Renders SCENE (a .gltf/.glb file or a bundled scene name; default cornell-glass) headless and\n"
-               "writes the mean radiance of each pixel. Linear outputs are not tone-mapped or clamped.",
+               "writes the mean radiance of each pixel. Linear outputs are not tone-mapped or clamped.\n"
+               "Ctrl-C (SIGINT) or SIGTERM finishes the current pass, writes the image so far and a\n"
+               "checkpoint, and exits with status 4; a second Ctrl-C aborts at once.",
                specs);
   if (!opts.parse(args)) return 0;
   bool quiet = opts.has("--quiet");
@@ -33,9 +42,24 @@ int cmdRender(const std::vector<std::string>& args) {
   tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", 0.0));
   tone.curve = parseToneCurve(opts.get("--tonemap", "aces"));
   Backend backend = parseBackend(opts.get("--backend", "auto"));
+  const double checkpointSeconds = opts.getDouble("--checkpoint", 0.0);
+  if (opts.has("--checkpoint") && !(checkpointSeconds > 0.0))
+    throw Error("option --checkpoint needs a number of seconds above 0");
+  const std::string checkpointFile = opts.get("--checkpoint-file", out + ".ckpt");
+  checkWritableFile(out, "output");
+  checkWritableFile(checkpointFile, "checkpoint");
+  std::optional<Checkpoint> resumeFrom;
+  const std::string resumePath = opts.get("--resume", "");
+  if (opts.has("--resume")) resumeFrom = readCheckpoint(resumePath);  // a bad file fails before any work
 
   LoadedScene ls = loadSceneForCli(opts, !quiet);
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
+  const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
+  const std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
+  if (resumeFrom) {
+    std::string diff = checkpointMismatch(*resumeFrom, sceneHash, settingsText);
+    if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
+  }
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);
   note(quiet, "OpenGL (" + context->backendName() + "): " + glInfo);
@@ -46,9 +70,26 @@ int cmdRender(const std::vector<std::string>& args) {
                   renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
                   integratorName(settings.integrator));
+  if (resumeFrom) {
+    renderer.restoreAccumulation(resumeFrom->state);
+    note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");
+  }
 
+  auto saveCheckpoint = [&] {
+    Checkpoint ck;
+    ck.state = renderer.saveAccumulation();
+    ck.seed = settings.seed;
+    ck.sceneHash = sceneHash;
+    ck.settingsText = settingsText;
+    writeCheckpoint(checkpointFile, ck);
+  };
+  ProgressHooks hooks;
+  hooks.stopOnInterrupt = true;
+  hooks.checkpointSeconds = checkpointSeconds;
+  hooks.checkpoint = saveCheckpoint;
+  installInterruptHandlers();
   auto start = std::chrono::steady_clock::now();
-  renderWithProgress(renderer, spp, "", quiet);
+  const bool complete = renderWithProgress(renderer, spp, "", quiet, hooks);
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const RenderStats& st = renderer.stats();
   char line[256];
@@ -56,6 +97,20 @@ int cmdRender(const std::vector<std::string>& args) {
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
   writeImage(out, renderer.image(), tone);
+  if (!complete) {
+    // Always said, even with --quiet: it explains the exit status.
+    std::string saved;
+    try {
+      saveCheckpoint();
+      saved = " and checkpoint " + checkpointFile + " (continue with --resume " + checkpointFile + ")";
+    } catch (const Error& e) {
+      saved = "; no checkpoint: " + std::string(e.what());
+    }
+    std::fprintf(stderr, "caustica: interrupted at %d/%d spp after %.0f s; wrote %s (partial)%s\n",
+                 renderer.samplesPerPixel(), spp, total, out.c_str(), saved.c_str());
+    return kExitInterrupted;
+  }
+  if (checkpointSeconds > 0.0) saveCheckpoint();  // so that the render can be extended later
   note(quiet, "wrote " + std::filesystem::absolute(out).string());
   return 0;
 }

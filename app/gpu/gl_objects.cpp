@@ -114,6 +114,17 @@ std::vector<float> GlTexture::readRgba32f() const {
   return out;
 }
 
+void GlTexture::uploadRgba32f(const std::vector<float>& rgba) {
+  if (format_ != GL_RGBA32F || rgba.size() != static_cast<std::size_t>(width_) * height_ * 4)
+    throw Error("internal: uploadRgba32f needs an rgba32f texture and width*height*4 floats");
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glBindTexture(GL_TEXTURE_2D, id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, rgba.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("image upload");
+}
+
 GlProgram GlProgram::compileCompute(const std::string& source,
                                     const std::function<std::string(const std::string&)>& mapLog,
                                     const std::string& name) {

@@ -70,6 +70,8 @@ class GlTexture {
   void clear();  // zero every texel
   void bindImage(GLuint unit, GLenum access) const;
   std::vector<float> readRgba32f() const;  // width*height*4 floats, row 0 first
+  // Replaces every texel of an rgba32f texture with `rgba` (width*height*4 floats, row 0 first).
+  void uploadRgba32f(const std::vector<float>& rgba);
   int width() const { return width_; }
   int height() const { return height_; }
   GLuint id() const { return handle_.id(); }

@@ -200,6 +200,31 @@ void Renderer::readCounters() {
   buf.update(0, sizeof zero, &zero);
 }
 
+AccumulationState Renderer::saveAccumulation() const {
+  AccumulationState st;
+  st.width = settings_.width;
+  st.height = settings_.height;
+  st.spp = spp_;
+  st.sampleBase = sampleBase_;
+  st.accum = accum_.readRgba32f();
+  st.comp = comp_.readRgba32f();
+  return st;
+}
+
+void Renderer::restoreAccumulation(const AccumulationState& state) {
+  const size_t n = static_cast<size_t>(settings_.width) * settings_.height * 4;
+  if (state.width != settings_.width || state.height != settings_.height)
+    throw Error("the saved accumulation is " + std::to_string(state.width) + "x" + std::to_string(state.height) +
+                " but the renderer is " + std::to_string(settings_.width) + "x" + std::to_string(settings_.height));
+  if (state.accum.size() != n || state.comp.size() != n || state.spp < 0)
+    throw Error("the saved accumulation is incomplete");
+  reset();
+  accum_.uploadRgba32f(state.accum);
+  comp_.uploadRgba32f(state.comp);
+  spp_ = state.spp;
+  sampleBase_ = state.sampleBase;
+}
+
 Image Renderer::image() const {
   std::vector<float> rgba = accum_.readRgba32f();
   Image img{settings_.width, settings_.height, std::vector<float>(static_cast<size_t>(settings_.width) * settings_.height * 3)};

@@ -25,6 +25,15 @@ struct RenderStats {
   std::uint64_t rays() const { return primaryRays + secondaryRays + shadowRays; }
 };
 
+// The running sums of a progressive render: enough to continue it exactly where it stopped.
+struct AccumulationState {
+  int width = 0, height = 0;
+  int spp = 0;                  // samples per pixel accumulated
+  std::uint32_t sampleBase = 0;  // global index of the next sample (the RNG's sample dimension)
+  std::vector<float> accum;     // rgba32f running sums (rgb radiance, a = sample count), width*height*4
+  std::vector<float> comp;      // rgba32f Kahan compensation terms of those sums, width*height*4
+};
+
 class Renderer {
  public:
   // Needs a current GL 4.3 context. Throws Error if the scene exceeds the GL limits.
@@ -44,6 +53,11 @@ class Renderer {
   void renderPass(int spp) { renderRows(0, settings_.height, spp); endPass(spp); }
 
   int samplesPerPixel() const { return spp_; }
+  // Reads back both accumulation images and the sample counters (for checkpoints).
+  AccumulationState saveAccumulation() const;
+  // Continues from `state` (saved from a renderer with the same scene and settings): the next pass
+  // renders exactly the samples an uninterrupted render would. Throws Error unless its size matches.
+  void restoreAccumulation(const AccumulationState& state);
   Image image() const;                           // mean radiance per pixel (linear)
   // Tone-maps the accumulation into the rgba8 display texture (viewer).
   const GlTexture& updateDisplay(const ToneMapSettings& tone);

@@ -1,0 +1,184 @@
+// checkpoint.cpp — checkpoint file format: a text header after the magic line, then the two images'
+// raw floats (native little-endian), protected by an FNV-1a 64 checksum.
+#include "cli/checkpoint.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "cli/bench/bench_metrics.h"
+#include "util/error.h"
+
+namespace caustica::cli {
+namespace fs = std::filesystem;
+
+std::string checkpointSettingsText(const RenderSettings& s, int cameraIndex, const Camera& c) {
+  std::ostringstream t;
+  t << std::setprecision(9);
+  t << "size " << s.width << 'x' << s.height << '\n'
+    << "seed " << s.seed << '\n'
+    << "max-depth " << s.maxDepth << '\n'
+    << "integrator " << integratorName(s.integrator) << '\n'
+    << "dispersion " << dispersionModeName(s.dispersion) << '\n'
+    << "caster-probability " << s.casterProbability << '\n'
+    << "camera " << cameraIndex << '\n'
+    << "camera-view " << c.position.x << ' ' << c.position.y << ' ' << c.position.z << ' ' << c.forward.x << ' '
+    << c.forward.y << ' ' << c.forward.z << ' ' << c.up.x << ' ' << c.up.y << ' ' << c.up.z << ' ' << c.yfov << ' '
+    << c.aspect << '\n';
+  return t.str();
+}
+
+namespace {
+
+std::uint64_t dataHash(const AccumulationState& st) {
+  std::uint64_t h = fnv1a64(st.accum.data(), st.accum.size() * sizeof(float));
+  return fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
+}
+
+void writeAll(int fd, const void* data, size_t bytes, const std::string& tmp) {
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0) {
+    ssize_t n = ::write(fd, p, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
+    p += n;
+    bytes -= static_cast<size_t>(n);
+  }
+}
+
+std::map<std::string, std::string> parseLines(const std::string& text) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    size_t sp = line.find(' ');
+    m[line.substr(0, sp)] = sp == std::string::npos ? "" : line.substr(sp + 1);
+  }
+  return m;
+}
+
+}  // namespace
+
+void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
+  const AccumulationState& st = ck.state;
+  const size_t n = static_cast<size_t>(st.width) * st.height * 4;
+  if (st.accum.size() != n || st.comp.size() != n) throw Error("internal: checkpoint images do not match its size");
+  std::ostringstream h;
+  h << kCheckpointMagic << ' ' << kCheckpointVersion << '\n'
+    << "width " << st.width << '\n'
+    << "height " << st.height << '\n'
+    << "spp " << st.spp << '\n'
+    << "sample-base " << st.sampleBase << '\n'
+    << "seed " << ck.seed << '\n'
+    << "scene " << hex64(ck.sceneHash) << '\n'
+    << "data " << hex64(dataHash(st)) << '\n'
+    << "settings " << ck.settingsText.size() << '\n'
+    << ck.settingsText << "end\n";
+  const std::string header = h.str();
+  const std::string tmp = path + ".tmp";
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(tmp + ": cannot create the checkpoint (" + std::strerror(errno) + ")");
+  try {
+    writeAll(fd, header.data(), header.size(), tmp);
+    writeAll(fd, st.accum.data(), n * sizeof(float), tmp);
+    writeAll(fd, st.comp.data(), n * sizeof(float), tmp);
+    if (::fsync(fd) != 0) throw Error(tmp + ": cannot sync the checkpoint (" + std::strerror(errno) + ")");
+  } catch (...) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  if (::close(fd) != 0) {
+    ::unlink(tmp.c_str());
+    throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    int e = errno;
+    ::unlink(tmp.c_str());
+    throw Error(path + ": cannot rename the temporary checkpoint into place (" + std::strerror(e) + ")");
+  }
+  // Make the rename itself durable.
+  std::string dir = fs::path(path).parent_path().string();
+  int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+Checkpoint readCheckpoint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the checkpoint");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto bad = [&](const std::string& why) { return Error(path + ": not a usable caustica checkpoint: " + why); };
+  const std::string magic = std::string(kCheckpointMagic) + ' ';
+  if (bytes.compare(0, magic.size(), magic) != 0) throw bad("no " + std::string(kCheckpointMagic) + " header");
+  size_t end = bytes.find("\nend\n");
+  size_t settingsAt = bytes.find("\nsettings ");
+  if (end == std::string::npos || settingsAt == std::string::npos || settingsAt > end) throw bad("truncated header");
+  size_t settingsLineEnd = bytes.find('\n', settingsAt + 1);
+  std::map<std::string, std::string> head = parseLines(bytes.substr(0, settingsLineEnd));
+  auto num = [&](const char* key) -> unsigned long long {
+    auto it = head.find(key);
+    if (it == head.end() || it->second.empty()) throw bad(std::string("no ") + key + " in the header");
+    char* e = nullptr;
+    unsigned long long v = std::strtoull(it->second.c_str(), &e, key == std::string("scene") || key == std::string("data") ? 16 : 10);
+    if (*e != '\0') throw bad(std::string("bad ") + key + " '" + it->second + "'");
+    return v;
+  };
+  if (num(kCheckpointMagic) != static_cast<unsigned long long>(kCheckpointVersion))
+    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads version " + std::to_string(kCheckpointVersion) + ")");
+  Checkpoint ck;
+  AccumulationState& st = ck.state;
+  unsigned long long w = num("width"), hgt = num("height"), settingsBytes = num("settings");
+  if (w < 1 || hgt < 1 || w > kMaxImageSide || hgt > kMaxImageSide) throw bad("bad image size");
+  st.width = static_cast<int>(w);
+  st.height = static_cast<int>(hgt);
+  unsigned long long spp = num("spp");
+  if (spp > (1ull << 31)) throw bad("bad spp");
+  st.spp = static_cast<int>(spp);
+  st.sampleBase = static_cast<std::uint32_t>(num("sample-base"));
+  ck.seed = static_cast<std::uint32_t>(num("seed"));
+  ck.sceneHash = num("scene");
+  const std::uint64_t expected = num("data");
+  if (settingsLineEnd + 1 + settingsBytes != end + 1) throw bad("settings text of the wrong length");
+  ck.settingsText = bytes.substr(settingsLineEnd + 1, settingsBytes);
+  const size_t dataAt = end + 5;
+  const size_t n = static_cast<size_t>(w) * hgt * 4;
+  if (bytes.size() != dataAt + 2 * n * sizeof(float))
+    throw bad("holds " + std::to_string(bytes.size() - dataAt) + " bytes of image data, expected " +
+              std::to_string(2 * n * sizeof(float)) + " (truncated?)");
+  st.accum.resize(n);
+  st.comp.resize(n);
+  std::memcpy(st.accum.data(), bytes.data() + dataAt, n * sizeof(float));
+  std::memcpy(st.comp.data(), bytes.data() + dataAt + n * sizeof(float), n * sizeof(float));
+  if (dataHash(st) != expected) throw bad("the image data fails its checksum (corrupted)");
+  return ck;
+}
+
+std::string checkpointMismatch(const Checkpoint& ck, std::uint64_t sceneHash, const std::string& settingsText) {
+  std::vector<std::string> diffs;
+  std::map<std::string, std::string> a = parseLines(ck.settingsText), b = parseLines(settingsText);
+  for (const auto& [key, value] : b) {
+    auto it = a.find(key);
+    std::string saved = it == a.end() ? "(none)" : it->second;
+    if (saved != value) diffs.push_back(key + ": checkpoint " + saved + ", this render " + value);
+  }
+  for (const auto& [key, value] : a)
+    if (!b.count(key)) diffs.push_back(key + ": checkpoint " + value + ", this render (none)");
+  if (ck.sceneHash != sceneHash)
+    diffs.push_back("scene files differ (checkpoint " + hex64(ck.sceneHash) + ", this scene " + hex64(sceneHash) + ")");
+  std::string out;
+  for (const auto& d : diffs) out += (out.empty() ? "" : "; ") + d;
+  return out;
+}
+
+}  // namespace caustica::cli

@@ -1,0 +1,38 @@
+// checkpoint.h — the checkpoint file of a long render (`render --checkpoint`, `--resume`): the running
+// sums, sample counters, seed, scene fingerprint and image-changing settings. Format and I/O only, no GL.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "gpu/render_settings.h"
+#include "gpu/renderer.h"
+#include "scene/scene.h"
+
+namespace caustica::cli {
+
+constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
+constexpr int kCheckpointVersion = 1;
+
+struct Checkpoint {
+  AccumulationState state;        // both rgba32f images, spp and the next global sample index
+  std::uint32_t seed = 0;
+  std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
+  std::string settingsText;       // checkpointSettingsText(...)
+};
+
+// The settings that change the image, one "key value" a line (size, seed, max-depth, integrator,
+// dispersion, caster-probability, camera): two renders may share samples only if these are equal.
+std::string checkpointSettingsText(const RenderSettings& settings, int cameraIndex, const Camera& camera);
+
+// Writes `path` atomically: a temporary file in the same folder (path + ".tmp"), fsync, rename. An
+// interrupted write leaves the previous checkpoint intact. Throws Error naming the file on failure.
+void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint);
+// Reads and verifies (magic, version, sizes, checksum of the data); throws Error naming the file if
+// it is not a checkpoint, truncated or corrupted.
+Checkpoint readCheckpoint(const std::string& path);
+
+// "" when `checkpoint` belongs to this scene and these settings; otherwise what differs, e.g.
+// "seed: checkpoint 1, this render 2; scene files differ (checkpoint 0123..., this scene 4567...)".
+std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t sceneHash, const std::string& settingsText);
+
+}  // namespace caustica::cli

@@ -1,0 +1,30 @@
+# bad_output_paths.cmake — an output or checkpoint path that cannot be written fails with exit 1 and
+# a message naming it before the scene is even loaded (run with cmake -P; CLI and DIR given).
+file(REMOVE_RECURSE ${DIR})
+file(MAKE_DIRECTORY ${DIR}/folder.png)
+function(expect_refusal pattern)
+  string(TIMESTAMP t0 "%s")
+  # A large render: if the check came after rendering, this would take minutes, not a second.
+  execute_process(COMMAND ${CLI} render cornell-glass --size 512 --spp 100000 --backend osmesa ${ARGN}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err TIMEOUT 60)
+  string(TIMESTAMP t1 "%s")
+  math(EXPR dt "${t1} - ${t0}")
+  if(NOT rc EQUAL 1 OR NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "render ${ARGN}: exit ${rc}, expected 1 and '${pattern}': ${err}")
+  endif()
+  if(dt GREATER 5)
+    message(FATAL_ERROR "render ${ARGN} took ${dt} s to refuse a bad path")
+  endif()
+  if(err MATCHES "OpenGL")
+    message(FATAL_ERROR "render ${ARGN} created a context before refusing: ${err}")
+  endif()
+  message(STATUS "${err}")
+endfunction()
+expect_refusal("${DIR}/missing/out.png: cannot write the output: folder '${DIR}/missing' does not exist" -o ${DIR}/missing/out.png)
+expect_refusal("${DIR}/folder.png: cannot write the output: it is a folder" -o ${DIR}/folder.png)
+expect_refusal("${DIR}/nope/c.ckpt: cannot write the checkpoint: folder '${DIR}/nope' does not exist"
+               -o ${DIR}/out.png --checkpoint 10 --checkpoint-file ${DIR}/nope/c.ckpt)
+expect_refusal("${DIR}/gone.ckpt: cannot open the checkpoint" -o ${DIR}/out.png --resume ${DIR}/gone.ckpt)
+if(EXISTS ${DIR}/out.png)
+  message(FATAL_ERROR "a refused render wrote an image")
+endif()

@@ -1,0 +1,66 @@
+// resume_test.cpp — a render saved to a checkpoint file at 8 spp and resumed to 16 spp in a new
+// renderer must equal a straight 16-spp render (render --checkpoint / --resume).
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "cli/checkpoint.h"
+#include "gl_test_util.h"
+#include "util/error.h"
+
+using namespace caustica;
+using namespace caustica::test;
+
+TEST_CASE("resume from a checkpoint: 8 spp + 8 spp equals 16 spp bit for bit") {
+  Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
+  Camera camera = sceneCamera(scene);
+  RenderSettings rs;
+  rs.width = 16;
+  rs.height = 12;
+  rs.seed = 11;
+  static ShaderLibrary library;
+  std::string path = (std::filesystem::temp_directory_path() / "caustica-resume-test.ckpt").string();
+
+  Renderer straight(library, scene, camera, rs);
+  straight.renderPass(5);
+  straight.renderPass(11);
+  Image expected = straight.image();
+  AccumulationState expectedState = straight.saveAccumulation();
+
+  {
+    Renderer first(library, scene, camera, rs);
+    first.renderPass(3);
+    first.renderPass(5);
+    cli::Checkpoint ck;
+    ck.state = first.saveAccumulation();
+    CHECK(ck.state.spp == 8);
+    CHECK(ck.state.sampleBase == 8u);
+    ck.seed = rs.seed;
+    ck.settingsText = cli::checkpointSettingsText(rs, 0, camera);
+    cli::writeCheckpoint(path, ck);
+  }
+  Renderer resumed(library, scene, camera, rs);
+  resumed.restoreAccumulation(cli::readCheckpoint(path).state);
+  CHECK(resumed.samplesPerPixel() == 8);
+  resumed.renderPass(8);
+  CHECK(resumed.samplesPerPixel() == 16);
+  Image got = resumed.image();
+  AccumulationState gotState = resumed.saveAccumulation();
+
+  REQUIRE(got.rgb.size() == expected.rgb.size());
+  double mean = 0.0;
+  size_t differing = 0;
+  for (size_t i = 0; i < got.rgb.size(); ++i) {
+    mean += expected.rgb[i];
+    if (std::memcmp(&got.rgb[i], &expected.rgb[i], sizeof(float)) != 0) ++differing;
+  }
+  CHECK(mean / double(got.rgb.size()) > 0.01);  // not a black image
+  CHECK(differing == 0);
+  CHECK(gotState.accum == expectedState.accum);  // the running sums and their compensation too
+  CHECK(gotState.comp == expectedState.comp);
+
+  Renderer wrongSize(library, scene, camera, [&] { RenderSettings s = rs; s.width = 8; return s; }());
+  CHECK_THROWS_AS(wrongSize.restoreAccumulation(gotState), Error);
+  std::filesystem::remove(path);
+}
