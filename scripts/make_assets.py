@@ -851,6 +851,53 @@ def bad_files():
     bin_at = 20 + json_len
     bin_len = struct.unpack("<I", glb[bin_at:bin_at + 4])[0]
     files["bin-chunk-overrun.glb"] = glb[:bin_at] + struct.pack("<I", bin_len + 8) + glb[bin_at + 4:]
+    files.update(hostile_files(put, variant, external_bin, texture))
+    return files
+
+
+def hostile_files(put, variant, external_bin, texture):
+    """Untrusted-input files (docs/untrusted-input.md): references out of the scene's folder and
+    declared sizes over the default limits. Each must be refused before anything is read or allocated."""
+    files = {}
+    # References that lead outside the folder: refused by name, the target never opened.
+    put("escape-dotdot-buffer.gltf", variant(external_bin("../../../../../../../../etc/passwd", 0)))
+    put("escape-absolute-buffer.gltf", variant(external_bin("/etc/hostname", 0)))
+    put("escape-percent-encoded-buffer.gltf", variant(external_bin("%2e%2e/%2E%2E/%2e%2e/etc/passwd", 0)))
+    put("escape-dotdot-image.gltf", variant(texture("../../../../../../../../etc/passwd")))
+    put("escape-absolute-image.gltf", variant(texture("/etc/passwd")))
+    # Declared sizes over the default limits (LoadOptions in app/scene/scene.h).
+    put("huge-buffer-length.gltf", variant(external_bin("huge.bin", 1 << 50)))
+
+    def many_buffers(d):
+        d["buffers"] += [{"byteLength": 100 << 20, "uri": "part-%d.bin" % i} for i in range(16)]
+    put("many-large-buffers.gltf", variant(many_buffers))
+
+    def many_huge_images(d):
+        # PNG headers declaring 8192x8192 RGBA (256 MiB decoded each) over a few bytes of junk:
+        # the fifth takes the total past the 1024 MiB default before it is decoded.
+        def chunk(kind, data):
+            body = kind + data
+            return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+        png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 8192, 8192, 8, 6, 0, 0, 0))
+               + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b""))
+        uri = "data:image/png;base64," + base64.b64encode(png).decode()
+        d["images"] = [{"uri": uri} for _ in range(8)]
+    put("many-huge-images.gltf", variant(many_huge_images))
+
+    # 10^15 declared triangles in one index accessor: refused before any accessor is decoded.
+    put("huge-accessor-count.gltf", variant(lambda d: d["accessors"][1].update(count=3 * 10 ** 15)))
+
+    def wide(d):
+        # 1000 sibling nodes instancing a mesh of 10^6 (zero, unstored) triangles: 10^9 in all.
+        d["accessors"].append({"componentType": FLOAT, "count": 3000000, "type": "VEC3"})
+        d["meshes"].append({"primitives": [{"attributes": {"POSITION": 2}, "material": 0}]})
+        d["nodes"] = [{"mesh": 0, "children": list(range(1, 1001))}] + [{"mesh": 1}] * 1000
+    files["wide-node-tree.gltf"] = (json.dumps(variant(wide), separators=(",", ":")) + "\n").encode()
+
+    def deep(d):
+        # A chain of 1100 nodes, each scaling by 2: the world transform overflows 2^1024 down the chain.
+        d["nodes"] = [{"children": [i + 1], "scale": [2.0, 2.0, 2.0]} for i in range(1099)] + [{"mesh": 0}]
+    files["deep-node-tree.gltf"] = (json.dumps(variant(deep), separators=(",", ":")) + "\n").encode()
     return files
 
 

@@ -111,7 +111,7 @@ double Options::getDouble(const std::string& name, double fallback) const {
 }
 
 std::vector<OptionSpec> sceneOptionSpecs() {
-  return {
+  std::vector<OptionSpec> specs = {
       {"--size", "", "W[xH]", "image size in pixels (default 512; H follows the camera's aspect)"},
       {"--seed", "", "S", "random seed (default 1); the same seed gives the same image"},
       {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
@@ -124,6 +124,33 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
       {"--quiet", "-q", "", "print nothing but errors"},
   };
+  for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
+  return specs;
+}
+
+std::vector<OptionSpec> sceneInputOptionSpecs() {
+  const LoadOptions defaults;
+  return {
+      {"--allow-outside-paths", "", "",
+       "let the scene's buffer and image files lie outside its folder (absolute paths, '..', symlinks)"},
+      {"--max-texture-mib", "", "N",
+       "refuse scenes whose images decode to more than N MiB in all (default " +
+           std::to_string(defaults.maxTextureBytes >> 20) + ")"},
+      {"--max-buffer-mib", "", "N",
+       "refuse scenes whose buffers declare more than N MiB in all (default " +
+           std::to_string(defaults.maxBufferBytes >> 20) + ")"},
+      {"--max-triangles", "", "N",
+       "refuse scenes with more than N triangles (default " + std::to_string(defaults.maxTriangles) + ")"},
+  };
+}
+
+LoadOptions loadOptionsFrom(const Options& opts) {
+  LoadOptions o;
+  o.allowOutsidePaths = opts.has("--allow-outside-paths");
+  o.maxTextureBytes = std::uint64_t(opts.getInt("--max-texture-mib", int(o.maxTextureBytes >> 20), 1, 1 << 20)) << 20;
+  o.maxBufferBytes = std::uint64_t(opts.getInt("--max-buffer-mib", int(o.maxBufferBytes >> 20), 1, 1 << 20)) << 20;
+  o.maxTriangles = std::uint64_t(opts.getInt("--max-triangles", int(o.maxTriangles), 1, 1 << 30));
+  return o;
 }
 
 OptionSpec sceneOptionSpec(const std::string& name) {
@@ -242,9 +269,10 @@ void note(bool quiet, const std::string& line) {
 int cameraIndexFrom(const Options& opts) { return opts.getInt("--camera", 0, 0, 1 << 20); }
 
 LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose) {
+  const LoadOptions loadOptions = loadOptionsFrom(opts);  // option errors before any file is read
   std::string path = resolveScenePath(nameOrPath);
   LoadedScene ls;
-  ls.scene = loadScene(path);
+  ls.scene = loadScene(path, loadOptions);
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {

@@ -49,6 +49,13 @@ std::vector<OptionSpec> sceneOptionSpecs();
 // The entry of sceneOptionSpecs() named `name` (for commands that take only some of them).
 OptionSpec sceneOptionSpec(const std::string& name);
 
+// Options of every command that loads a scene (render, view, bench, info): how far an untrusted
+// scene file is trusted (docs/untrusted-input.md). Part of sceneOptionSpecs().
+std::vector<OptionSpec> sceneInputOptionSpecs();
+// --allow-outside-paths, --max-texture-mib, --max-buffer-mib and --max-triangles as LoadOptions
+// (defaults: LoadOptions{}); each bad value is an error naming the option.
+LoadOptions loadOptionsFrom(const Options& opts);
+
 // Parses "W" or "WxH". With only W, H follows the camera's aspect ratio (or is W).
 void parseSize(const std::string& text, float cameraAspect, int& width, int& height);
 

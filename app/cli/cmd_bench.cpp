@@ -31,6 +31,7 @@ int cmdBench(const std::vector<std::string>& args) {
       sceneOptionSpec("--shader-dir"),
       {"--quiet", "-q", "", "print nothing but errors and the summary table"},
   };
+  for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   Options opts("caustica bench [SCENE...] [options]",
                "Measures run time against error: for each SCENE (default: every bundled scene), each estimator\n"
                "and each dispersion mode the scene uses, renders progressively and records relMSE against a\n"

@@ -32,10 +32,12 @@ std::string vec(const glm::vec3& v) {
 }  // namespace
 
 int cmdInfo(const std::vector<std::string>& args) {
-  Options opts("caustica info SCENE [--camera N]",
+  std::vector<OptionSpec> specs = {{"--camera", "", "N", "describe the scene's N-th camera (default 0)"}};
+  for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
+  Options opts("caustica info SCENE [--camera N] [options]",
                "Prints triangles, emitters (count, total power), materials by kind, bounds, camera,\n"
                "BVH statistics and the shader features the scene needs. Needs no GPU.",
-               {{"--camera", "", "N", "describe the scene's N-th camera (default 0)"}});
+               specs);
   if (!opts.parse(args)) return 0;
   if (opts.positional().empty()) throw Error("info needs a scene (a .gltf/.glb file or a bundled scene name)");
   LoadedScene ls = loadSceneForCli(opts, true);

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -33,7 +34,6 @@ constexpr std::uint64_t kMaxIndex = 0x7fffffff;         // any glTF index (tinyg
 constexpr std::uint64_t kMaxByteCount = 1ull << 53;     // byte lengths/offsets (exact in a double)
 constexpr std::uint64_t kMaxZeroElements = 1ull << 22;  // elements of an accessor without bufferView
 constexpr std::uint64_t kMaxDecoded = 1ull << 28;       // accessor elements decoded for the whole scene
-constexpr std::size_t kMaxTriangles = 1u << 24;         // triangles in a scene (GPU buffers: 112 B each)
 constexpr int kMaxTextureSide = 16384;                  // texels
 constexpr std::int64_t kMaxTexturePixels = 1ll << 26;   // texels in one texture (256 MiB as RGBA8)
 constexpr std::size_t kMaxMessage = 300;                // characters kept from a third-party message
@@ -45,13 +45,32 @@ std::string oneLine(const std::string& text);
 inline std::string str(std::uint64_t v) { return std::to_string(v); }
 std::string num(double v);
 
+// A byte count for messages: "1280 MiB", "1.5 MiB"; under 1 MiB "2048 bytes".
+std::string mib(std::uint64_t bytes);
+
+// ---- file references (gltf_loader.cpp) -----------------------------------------------------------
+// Where external files (buffers, images) may come from: the scene's folder unless the options allow more.
+struct FileAccess {
+  std::string baseDir;             // the scene file's folder as given ("" = the current directory)
+  std::filesystem::path folder;    // the same, absolute with symlinks resolved
+  bool allowOutside = false;       // LoadOptions::allowOutsidePaths
+};
+// True when `file` (a path as the system would open it) resolves, symlinks followed, to a path inside
+// access.folder (compared component by component), or when access.allowOutside.
+bool insideFolder(const FileAccess& access, const std::filesystem::path& file);
+// True when the percent-decoded relative URI `reference` is allowed: it is not absolute, does not
+// climb out with '..' (both decided without touching the file system) and resolves inside the folder.
+bool referenceAllowed(const FileAccess& access, const std::string& reference);
+
 // ---- JSON structure check (gltf_json_check.cpp) --------------------------------------------------
 // True for the extensions caustica implements (KHR_materials_*).
 bool isSupportedExtension(const std::string& name);
 // Rejects JSON nested deeper than kMaxJsonDepth, invalid JSON and documents whose structure tinygltf
-// would not check (types, indices, byte ranges, buffer sources). baseDir: folder of external files;
+// would not check (types, indices, byte ranges, buffer sources), external references that lead
+// outside access.folder and buffers whose byteLengths add up to more than options.maxBufferBytes.
 // binary: jsonText is a GLB's JSON chunk. Throws Error("PATH: ...").
-void checkJson(const std::string& path, const std::string& jsonText, const std::string& baseDir, bool binary);
+void checkJson(const std::string& path, const std::string& jsonText, const FileAccess& access, bool binary,
+               const LoadOptions& options);
 
 // ---- byte access (gltf_accessors.cpp) ------------------------------------------------------------
 // True when `count` elements of `elem` bytes, `stride` bytes apart, starting at `offset`, lie inside
@@ -72,9 +91,13 @@ struct Format {
 // an unused broken image does not stop loading; using it is an error (SceneBuilder::texture).
 struct ImageLog {
   std::map<int, std::string> failures;  // image index -> reason
+  std::uint64_t budget = 0;             // LoadOptions::maxTextureBytes
+  std::uint64_t declared = 0;           // RGBA8 bytes of the images met so far, by their headers
+  std::string overBudget;               // set when an image would exceed the budget: loading fails
 };
 
-// tinygltf's image-loader callback; `user` is the ImageLog.
+// tinygltf's image-loader callback; `user` is the ImageLog. An image whose header's size would take
+// the decoded total over the budget is not decoded: it sets overBudget and returns false.
 bool decodeImage(tinygltf::Image* image, int index, std::string*, std::string*, int, int, const unsigned char* bytes,
                  int size, void* user);
 
@@ -90,8 +113,9 @@ struct NodeTransform {
 // walk, meshes, cameras), gltf_materials.cpp (materials, textures) and gltf_accessors.cpp (accessors).
 class SceneBuilder {
  public:
-  SceneBuilder(const std::string& path, const tinygltf::Model& model, const ImageLog& images, Scene& scene)
-      : path_(path), model_(model), images_(images), scene_(scene) {}
+  SceneBuilder(const std::string& path, const tinygltf::Model& model, const ImageLog& images,
+               const LoadOptions& options, Scene& scene)
+      : path_(path), model_(model), images_(images), options_(options), scene_(scene) {}
 
   void build();
 
@@ -116,6 +140,9 @@ class SceneBuilder {
   glm::dmat4 localMatrix(const tinygltf::Node& node, const std::string& at);
   std::vector<int> checkHierarchy();
   void traverse();  // fills cameraInstances_ and meshInstances_
+  // Refuses a scene whose mesh instances declare more than options_.maxTriangles triangles (from
+  // accessor counts), before any accessor is decoded.
+  void checkTriangleCount() const;
   // The world-space point (scene units, double) that becomes the float origin: for a scene farther
   // from the world origin than its size, the centre of the meshes' bounds from their POSITION
   // accessors' min/max (node origins where those are missing); else 0.
@@ -142,6 +169,7 @@ class SceneBuilder {
   const std::string& path_;
   const tinygltf::Model& model_;
   const ImageLog& images_;
+  const LoadOptions& options_;
   Scene& scene_;
   std::map<int, int> textureMap_;  // glTF texture index -> Scene::textures index (-1: ignored)
   int defaultMaterial_ = -1;

@@ -54,9 +54,9 @@ int jsonDepth(const char* text, std::size_t size, int limit) {
 // byte ranges; this pass rejects such files with a message naming the property.
 class JsonChecker {
  public:
-  // baseDir: folder of external files; binary: the document is a GLB's JSON chunk.
-  JsonChecker(const std::string& path, const std::string& baseDir, bool binary)
-      : path_(path), baseDir_(baseDir), binary_(binary) {}
+  // access: where external files may come from; binary: the document is a GLB's JSON chunk.
+  JsonChecker(const std::string& path, const FileAccess& access, bool binary, const LoadOptions& options)
+      : path_(path), access_(access), binary_(binary), options_(options) {}
 
   void check(const Json& root) {
     if (!root.is_object()) fail("the top-level JSON value is " + describe(root) + ", not an object");
@@ -71,6 +71,9 @@ class JsonChecker {
     forEach(root, "nodes", [&](const Json& o, const std::string& at) { checkNode(o, at); });
     forEach(root, "meshes", [&](const Json& o, const std::string& at) { checkMesh(root, o, at); });
     forEach(root, "accessors", [&](const Json& o, const std::string& at) { checkAccessor(root, o, at); });
+    // All declared byteLengths are added up before any buffer's file is looked at.
+    std::uint64_t bufferBytes = 0;
+    forEach(root, "buffers", [&](const Json& o, const std::string& at) { checkBufferLength(o, at, bufferBytes); });
     forEach(root, "buffers", [&](const Json& o, const std::string& at) { checkBuffer(o, at); });
     forEach(root, "bufferViews", [&](const Json& o, const std::string& at) { checkBufferView(root, o, at); });
     forEach(root, "images", [&](const Json& o, const std::string& at) { checkImage(root, o, at); });
@@ -316,9 +319,23 @@ class JsonChecker {
     }
   }
 
+  void checkBufferLength(const Json& o, const std::string& at, std::uint64_t& total) const {
+    const auto length = index(o, at, "byteLength", true, kMaxByteCount)->get<std::uint64_t>();
+    total = length > ~std::uint64_t(0) - total ? ~std::uint64_t(0) : total + length;  // saturating
+    if (total > options_.maxBufferBytes)
+      fail(join(at, "byteLength") + " is " + str(length) + ", which brings the buffers to " + mib(total) +
+           ", more than the limit of " + mib(options_.maxBufferBytes) + " (use --max-buffer-mib to raise it)");
+  }
+
+  // A reference to an external file: refused, naming it, when it leads outside the scene's folder.
+  void checkFileReference(const std::string& where, const std::string& uri) const {
+    if (!referenceAllowed(access_, uriDecode(uri)))
+      fail(where + " '" + oneLine(uri) + "' leads outside the scene's folder (use --allow-outside-paths to permit)");
+  }
+
   // Buffer sources are checked here so that the messages name the buffer (tinygltf's do not).
   void checkBuffer(const Json& o, const std::string& at) const {
-    const auto length = index(o, at, "byteLength", true, kMaxByteCount)->get<std::uint64_t>();
+    const auto length = o["byteLength"].get<std::uint64_t>();
     const Json* uriValue = string(o, at, "uri");
     if (!uriValue) {
       if (!binary_) fail(join(at, "uri") + " is missing (only a .glb file's buffer may omit it)");
@@ -339,7 +356,8 @@ class JsonChecker {
         fail(at + ": the data URI holds " + str(decoded) + " bytes but byteLength is " + str(length));
       return;
     }
-    const std::filesystem::path file = std::filesystem::path(baseDir_) / uriDecode(uri);
+    checkFileReference(join(at, "uri"), uri);
+    const std::filesystem::path file = std::filesystem::path(access_.baseDir) / uriDecode(uri);
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
       fail(join(at, "uri") + " '" + oneLine(uri) + "': file not found (" + oneLine(file.string()) + ")");
@@ -384,7 +402,10 @@ class JsonChecker {
 
   void checkImage(const Json& root, const Json& o, const std::string& at) const {
     if (!o.contains("uri") && !o.contains("bufferView")) fail(at + " has neither a uri nor a bufferView");
-    string(o, at, "uri");
+    if (const Json* uri = string(o, at, "uri")) {
+      const std::string text = uri->get<std::string>();
+      if (text.rfind("data:", 0) != 0) checkFileReference(join(at, "uri"), text);
+    }
     string(o, at, "mimeType");
     if (const Json* view = index(o, at, "bufferView")) {
       const Json* views = find(root, "bufferViews");
@@ -465,8 +486,9 @@ class JsonChecker {
   }
 
   std::string path_;
-  std::string baseDir_;
+  const FileAccess& access_;
   bool binary_;
+  const LoadOptions& options_;
 };
 
 }  // namespace
@@ -477,7 +499,8 @@ bool isSupportedExtension(const std::string& name) {
   return false;
 }
 
-void checkJson(const std::string& path, const std::string& jsonText, const std::string& baseDir, bool binary) {
+void checkJson(const std::string& path, const std::string& jsonText, const FileAccess& access, bool binary,
+               const LoadOptions& options) {
   if (jsonDepth(jsonText.data(), jsonText.size(), kMaxJsonDepth) > kMaxJsonDepth)
     throw Error(path + ": JSON is nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
   Json document;
@@ -490,7 +513,7 @@ void checkJson(const std::string& path, const std::string& jsonText, const std::
     throw Error(path + ": invalid JSON: " + oneLine(what));
   }
   try {
-    JsonChecker(path, baseDir, binary).check(document);
+    JsonChecker(path, access, binary, options).check(document);
   } catch (const Json::exception& e) {  // a check that assumed a JSON type it had not verified
     throw Error(path + ": unexpected JSON structure: " + oneLine(e.what()));
   }

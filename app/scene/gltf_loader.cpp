@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <iomanip>
 #include <new>
 #include <sstream>
 #include <string>
@@ -51,6 +52,36 @@ std::string num(double v) {
   return s.str();
 }
 
+std::string mib(std::uint64_t bytes) {
+  if (bytes < (1u << 20)) return str(bytes) + " bytes";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << double(bytes) / double(1u << 20);
+  std::string text = s.str();
+  if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) text.resize(text.size() - 2);
+  return text + " MiB";
+}
+
+bool insideFolder(const FileAccess& access, const std::filesystem::path& file) {
+  if (access.allowOutside) return true;
+  std::error_code ec;
+  const std::filesystem::path resolved = std::filesystem::weakly_canonical(file, ec);
+  if (ec) return false;
+  // Component by component, so that /a/bc is not taken to lie inside /a/b.
+  auto r = resolved.begin();
+  for (auto f = access.folder.begin(); f != access.folder.end(); ++f, ++r)
+    if (r == resolved.end() || *f != *r) return false;
+  return true;
+}
+
+bool referenceAllowed(const FileAccess& access, const std::string& reference) {
+  if (access.allowOutside) return true;
+  const std::filesystem::path ref(reference);
+  if (ref.has_root_path()) return false;  // absolute
+  const std::filesystem::path normal = ref.lexically_normal();
+  if (!normal.empty() && *normal.begin() == "..") return false;  // climbs out of the folder
+  return insideFolder(access, std::filesystem::path(access.baseDir) / ref);  // symlinks
+}
+
 namespace {
 
 std::string lowerExtension(const std::string& path) {
@@ -63,14 +94,30 @@ std::string lowerExtension(const std::string& path) {
 // ---- file reading --------------------------------------------------------------------------------
 // File access for tinygltf (external buffers and images): regular files only, read with the same
 // checks as the scene file itself (tinygltf's default reader trusts the size a directory reports).
-bool fsFileExists(const std::string& path, void*) {
+// `user` is the FileAccess: a file outside the scene's folder does not exist for tinygltf (the JSON
+// check has already refused such references by name; this also covers tinygltf's fallback of
+// looking in the current directory).
+bool fsFileExists(const std::string& path, void* user) {
+  if (!insideFolder(*static_cast<const FileAccess*>(user), path)) return false;
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
 
-std::string fsExpandFilePath(const std::string& path, void*) { return path; }
+// tinygltf joins the folder and the URI as text: an absolute URI (allowed by --allow-outside-paths)
+// arrives as "FOLDER//abs/path", which the system would read as FOLDER/abs/path.
+std::string fsExpandFilePath(const std::string& path, void* user) {
+  const FileAccess& access = *static_cast<const FileAccess*>(user);
+  const std::string joined = access.baseDir + "//";
+  if (!access.baseDir.empty() && access.baseDir != "/" && path.rfind(joined, 0) == 0)
+    return path.substr(access.baseDir.size() + 1);
+  return path;
+}
 
-bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  if (!insideFolder(*static_cast<const FileAccess*>(user), path)) {
+    if (err) *err += "'" + oneLine(path) + "' leads outside the scene's folder\n";
+    return false;
+  }
   try {
     *out = readFileBytes(path);
     return true;
@@ -114,7 +161,9 @@ std::string glbJson(const std::string& path, const std::vector<unsigned char>& b
 }  // namespace
 }  // namespace gltf
 
-Scene loadScene(const std::string& path) {
+Scene loadScene(const std::string& path) { return loadScene(path, LoadOptions{}); }
+
+Scene loadScene(const std::string& path, const LoadOptions& options) {
   using namespace gltf;  // the loader's internals (gltf_internal.h)
   const std::string ext = lowerExtension(path);
   if (ext != ".gltf" && ext != ".glb")
@@ -133,20 +182,29 @@ Scene loadScene(const std::string& path) {
   const std::string jsonText =
       binary ? glbJson(path, bytes) : std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 
-  const std::string baseDir = std::filesystem::path(path).parent_path().string();
-  checkJson(path, jsonText, baseDir, binary);
+  FileAccess access;
+  access.baseDir = std::filesystem::path(path).parent_path().string();
+  access.allowOutside = options.allowOutsidePaths;
+  {
+    std::error_code ec;
+    access.folder = std::filesystem::canonical(access.baseDir.empty() ? "." : access.baseDir, ec);
+    if (ec) throw Error(path + ": cannot resolve the scene's folder (" + oneLine(ec.message()) + ")");
+  }
+  checkJson(path, jsonText, access, binary, options);
 
   tinygltf::Model model;
   ImageLog imageLog;
+  imageLog.budget = options.maxTextureBytes;
   try {
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(decodeImage, &imageLog);
-    loader.SetFsCallbacks({fsFileExists, fsExpandFilePath, fsReadWholeFile, fsWriteWholeFile, nullptr});
+    loader.SetFsCallbacks({fsFileExists, fsExpandFilePath, fsReadWholeFile, fsWriteWholeFile, &access});
     std::string err, warn;
     const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                                         static_cast<unsigned int>(bytes.size()), baseDir)
+                                                         static_cast<unsigned int>(bytes.size()), access.baseDir)
                            : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(),
-                                                        static_cast<unsigned int>(jsonText.size()), baseDir);
+                                                        static_cast<unsigned int>(jsonText.size()), access.baseDir);
+    if (!imageLog.overBudget.empty()) throw Error(path + ": " + imageLog.overBudget);
     if (!ok) throw Error(path + ": " + (err.empty() ? std::string("tinygltf could not load the file") : oneLine(err)));
     if (!warn.empty()) scene.warnings.push_back(path + ": " + oneLine(warn));
   } catch (const Error&) {
@@ -156,7 +214,7 @@ Scene loadScene(const std::string& path) {
   }
 
   try {
-    SceneBuilder(path, model, imageLog, scene).build();
+    SceneBuilder(path, model, imageLog, options, scene).build();
   } catch (const Error&) {
     throw;
   } catch (const std::bad_alloc&) {

@@ -45,6 +45,14 @@ bool decodeImage(tinygltf::Image* image, const int index, std::string*, std::str
                            " is out of range (at most " + str(kMaxTextureSide) + " per side)";
     return true;
   }
+  const std::uint64_t decodedBytes = std::uint64_t(w) * std::uint64_t(h) * 4;
+  log->declared += decodedBytes;
+  if (log->declared > log->budget) {
+    log->overBudget = "images[" + str(std::uint64_t(std::max(index, 0))) + "] (" + str(std::uint64_t(w)) + "x" +
+                      str(std::uint64_t(h)) + ") brings the decoded textures to " + mib(log->declared) +
+                      ", more than the limit of " + mib(log->budget) + " (use --max-texture-mib to raise it)";
+    return false;
+  }
   unsigned char* pixels = stbi_load_from_memory(bytes, size, &w, &h, &channels, 4);
   if (!pixels) {
     const char* reason = stbi_failure_reason();

@@ -22,6 +22,7 @@ void SceneBuilder::build() {
   warnUnsupportedExtensions();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
   traverse();
+  checkTriangleCount();
   // Positions become float relative to the scene's centre, computed in double, so a scene far from
   // the world origin keeps the precision of one near it (docs/stability.md).
   origin_ = chooseOrigin();
@@ -46,6 +47,34 @@ void SceneBuilder::warnUnsupportedExtensions() {
   for (const std::string& ext : model_.extensionsUsed)
     if (!isSupportedExtension(ext)) list += (list.empty() ? "" : ", ") + oneLine(ext);
   if (!list.empty()) warn("ignoring unsupported extension(s): " + list);
+}
+
+void SceneBuilder::checkTriangleCount() const {
+  // Saturating sums: a hostile file may declare counts near 2^53 on many instances.
+  const std::uint64_t kSaturated = std::numeric_limits<std::uint64_t>::max() / 2;
+  std::uint64_t total = 0;
+  for (const MeshInstance& m : meshInstances_) {
+    if (m.mesh < 0 || std::size_t(m.mesh) >= model_.meshes.size()) continue;  // addMesh reports it
+    for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(m.mesh)].primitives) {
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+          prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
+        continue;
+      int source = prim.indices;
+      if (source < 0) {
+        const auto pos = prim.attributes.find("POSITION");
+        if (pos == prim.attributes.end()) continue;
+        source = pos->second;
+      }
+      if (source < 0 || std::size_t(source) >= model_.accessors.size()) continue;  // readAccessor reports it
+      const std::uint64_t n = model_.accessors[std::size_t(source)].count;
+      const std::uint64_t triangles = prim.mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : (n >= 3 ? n - 2 : 0);
+      total = std::min(kSaturated, total + std::min(kSaturated, triangles));
+      if (total > options_.maxTriangles)
+        fail(m.at + " (meshes[" + str(std::uint64_t(m.mesh)) + "]) brings the scene's declared triangles to " +
+             (total == kSaturated ? std::string("an absurd number") : str(total)) + ", more than the limit of " +
+             str(options_.maxTriangles) + " (use --max-triangles to raise it)");
+    }
+  }
 }
 
 // ---- node hierarchy ----
@@ -332,7 +361,8 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     triangles = n - 2;
   }
   candidates_ += triangles;  // counted before degenerate ones are dropped, so work stays bounded
-  if (candidates_ > kMaxTriangles) fail("the scene has more than " + str(kMaxTriangles) + " triangles");
+  if (candidates_ > options_.maxTriangles)
+    fail("the scene has more than " + str(options_.maxTriangles) + " triangles (use --max-triangles to raise the limit)");
 
   for (std::size_t t = 0; t < triangles; ++t) {
     std::uint32_t v[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};

@@ -89,7 +89,20 @@ struct Scene {
   glm::dvec3 origin{0.0};
 };
 
+// What loadScene accepts from a scene file it does not trust (docs/untrusted-input.md). Each limit
+// is checked before the memory it guards is spent; the defaults suit scenes up to a few GiB of GPU memory.
+struct LoadOptions {
+  // External files (buffers, images) must lie inside the scene file's folder, symlinks followed;
+  // true also lets them lead elsewhere (absolute paths, '..', symlinks out).
+  bool allowOutsidePaths = false;
+  std::uint64_t maxTextureBytes = 1ull << 30;  // decoded RGBA8 texels of all images together
+  std::uint64_t maxBufferBytes = 1ull << 30;   // sum of the buffers' declared byteLength
+  std::uint64_t maxTriangles = 1ull << 24;     // triangles in the scene (GPU buffers: 112 B each)
+};
+
 // Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
+Scene loadScene(const std::string& path, const LoadOptions& options);
+// The same with the default LoadOptions.
 Scene loadScene(const std::string& path);
 
 // A camera that frames the scene bounds (used when the file has none), looking down -Z.
