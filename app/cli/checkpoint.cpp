@@ -2,12 +2,8 @@
 // raw floats (native little-endian), protected by an FNV-1a 64 checksum.
 #include "cli/checkpoint.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -16,9 +12,9 @@
 
 #include "cli/bench/bench_metrics.h"
 #include "util/error.h"
+#include "util/file_io.h"
 
 namespace caustica::cli {
-namespace fs = std::filesystem;
 
 std::string checkpointSettingsText(const RenderSettings& s, int cameraIndex, const Camera& c) {
   std::ostringstream t;
@@ -41,17 +37,6 @@ namespace {
 std::uint64_t dataHash(const AccumulationState& st) {
   std::uint64_t h = fnv1a64(st.accum.data(), st.accum.size() * sizeof(float));
   return fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
-}
-
-void writeAll(int fd, const void* data, size_t bytes, const std::string& tmp) {
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0) {
-    ssize_t n = ::write(fd, p, bytes);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
-    p += n;
-    bytes -= static_cast<size_t>(n);
-  }
 }
 
 std::map<std::string, std::string> parseLines(const std::string& text) {
@@ -83,35 +68,15 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     << "settings " << ck.settingsText.size() << '\n'
     << ck.settingsText << "end\n";
   const std::string header = h.str();
-  const std::string tmp = path + ".tmp";
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw Error(tmp + ": cannot create the checkpoint (" + std::strerror(errno) + ")");
-  try {
-    writeAll(fd, header.data(), header.size(), tmp);
-    writeAll(fd, st.accum.data(), n * sizeof(float), tmp);
-    writeAll(fd, st.comp.data(), n * sizeof(float), tmp);
-    if (::fsync(fd) != 0) throw Error(tmp + ": cannot sync the checkpoint (" + std::strerror(errno) + ")");
-  } catch (...) {
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    throw;
-  }
-  if (::close(fd) != 0) {
-    ::unlink(tmp.c_str());
-    throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    int e = errno;
-    ::unlink(tmp.c_str());
-    throw Error(path + ": cannot rename the temporary checkpoint into place (" + std::strerror(e) + ")");
-  }
-  // Make the rename itself durable.
-  std::string dir = fs::path(path).parent_path().string();
-  int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  writeFileAtomically(path, ".tmp", [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(tmp + ": cannot create the checkpoint (" + std::strerror(errno) + ")");
+    out.write(header.data(), static_cast<std::streamsize>(header.size()));
+    out.write(reinterpret_cast<const char*>(st.accum.data()), static_cast<std::streamsize>(n * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(st.comp.data()), static_cast<std::streamsize>(n * sizeof(float)));
+    out.close();
+    if (!out) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
+  });
 }
 
 Checkpoint readCheckpoint(const std::string& path) {

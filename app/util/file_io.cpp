@@ -1,7 +1,11 @@
 // file_io.cpp — whole-file reading with clear errors (see file_io.h).
 #include "util/file_io.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -31,6 +35,33 @@ std::vector<unsigned char> readFileBytes(const std::string& path) {
 std::string readFileText(const std::string& path) {
   std::vector<unsigned char> bytes = readFileBytes(path);
   return std::string(bytes.begin(), bytes.end());
+}
+
+void writeFileAtomically(const std::string& path, const std::string& tmpSuffix,
+                         const std::function<void(const std::string& tmp)>& write) {
+  const std::string tmp = path + tmpSuffix;
+  try {
+    write(tmp);
+    const int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || ::fsync(fd) != 0) {
+      const int e = errno;
+      if (fd >= 0) ::close(fd);
+      throw Error(tmp + ": cannot flush to disk (" + std::strerror(e) + ")");
+    }
+    ::close(fd);
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+      throw Error(path + ": cannot rename the temporary file into place (" + std::strerror(errno) + ")");
+  } catch (...) {
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  // Make the rename itself durable.
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  const int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
 }
 
 }  // namespace caustica

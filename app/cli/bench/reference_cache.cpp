@@ -78,11 +78,7 @@ std::string defaultReferenceCacheDir() {
 }
 
 void writeImageAtomic(const std::string& path, const Image& image) {
-  std::string tmp = path + ".tmp.exr";
-  writeImage(tmp, image);
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw Error(path + ": cannot rename the temporary file (" + ec.message() + ")");
+  writeFileAtomically(path, ".tmp.exr", [&](const std::string& tmp) { writeImage(tmp, image); });
 }
 
 Reference givenReference(const std::string& file, int width, int height, bool quiet) {
