@@ -56,6 +56,9 @@ int cmdCompare(const std::vector<std::string>& args) {
   for (RenderMode mode : {RenderMode::Raster, RenderMode::Whitted, RenderMode::Path}) {
     settings.mode = mode;
     renderer.apply(settings);  // compiles the mode's shaders (not timed)
+    // Drivers compile at the first dispatch or draw (llvmpipe: about a second): one row first, so
+    // the time is the render's alone.
+    renderer.renderRows(0, 1, 1);
     renderer.reset();
     const int n = mode == RenderMode::Raster ? 1 : mode == RenderMode::Whitted ? whittedSpp : spp;
     auto t0 = std::chrono::steady_clock::now();
@@ -75,9 +78,14 @@ int cmdCompare(const std::vector<std::string>& args) {
     panels.push_back(std::move(p));
   }
   std::string name = std::filesystem::path(ls.scene.path).stem().string();
-  char title[160];
-  std::snprintf(title, sizeof title, "%s, %dx%d: raster, Whitted ray tracing, path tracing (%s)", name.c_str(),
-                settings.width, settings.height, glInfo.substr(0, 40).c_str());
+  // "vendor | renderer | version": the renderer names the GPU (or llvmpipe).
+  std::string gpuName = glInfo;
+  size_t bar = gpuName.find(" | ");
+  if (bar != std::string::npos) gpuName = gpuName.substr(bar + 3);
+  gpuName = gpuName.substr(0, gpuName.find(" | "));
+  char title[200];
+  std::snprintf(title, sizeof title, "%s, %dx%d, on %s", name.c_str(), settings.width, settings.height,
+                gpuName.substr(0, 60).c_str());
   Canvas figure = composeCompareFigure(panels, tone, title);
   writePng(out, figure.width, figure.height, figure.rgb);
   note(quiet, "wrote " + std::filesystem::absolute(out).string());
