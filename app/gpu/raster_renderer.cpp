@@ -379,6 +379,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     glDisable(GL_BLEND);
   }
   glDisable(GL_CLIP_DISTANCE0);
+  glDisable(GL_DEPTH_TEST);  // leave the state the compute passes and the viewer's blit expect
   glBindVertexArray(0);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
   glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
