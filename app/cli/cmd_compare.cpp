@@ -22,8 +22,11 @@ int cmdCompare(const std::vector<std::string>& args) {
       {"--exposure", "", "STOPS", "exposure in stops (default 0)"},
       {"--tonemap", "", "CURVE", "tone curve: aces (default) or clamp"},
   };
-  for (auto& s : sceneOptionSpecs())
-    if (s.name != "--mode") specs.push_back(s);
+  for (auto& s : sceneOptionSpecs()) {
+    if (s.name == "--mode") continue;  // compare renders every mode
+    if (s.name == "--size") s.help = "size of each panel in pixels (default 384; H follows the camera's aspect)";
+    specs.push_back(s);
+  }
   Options opts("caustica compare [SCENE] [options]",
                "Renders SCENE three ways (docs/render-modes.md) - the OpenGL rasterizer (Blinn-Phong, shadow\n"
                "maps, planar mirrors, blended glass), the Whitted ray tracer (sharp shadows, mirrors, refraction,\n"
