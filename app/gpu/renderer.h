@@ -85,6 +85,7 @@ class Renderer {
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
+  GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
   GlTexture accum_, comp_, display_;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;
