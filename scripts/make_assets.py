@@ -737,6 +737,49 @@ def punctual_lights_scene():
     return g.finish()
 
 
+def many_lights_scene(count=31, spacing=1.3, size=0.25, height=0.6):
+    """A floor under a count x count grid of small emissive quads (961 lights, 1,922 emissive
+    triangles), spread far apart, with boxes among them: every floor point is lit by its few nearest
+    lights, while power-proportional light selection picks one of those only rarely. For measuring
+    light selection (docs/path-tracer.md, "Many lights")."""
+    g = Gltf()
+    half = (count - 1) * spacing / 2.0 + 2.0
+    floor_mesh = MeshData()
+    floor_mesh.polygon([(-half, 0, -half), (half, 0, -half), (half, 0, half), (-half, 0, half)], (0, 1, 0))
+    white = g.material("white", color=WHITE)
+    g.object("floor", floor_mesh, white)
+    lights = MeshData()
+    h = size / 2.0
+    for i in range(count):
+        for j in range(count):
+            x = (i - (count - 1) / 2.0) * spacing
+            z = (j - (count - 1) / 2.0) * spacing
+            lights.polygon([(x - h, height, z - h), (x + h, height, z - h), (x + h, height, z + h),
+                            (x - h, height, z + h)], (0, -1, 0))
+    lamp = g.material("lamp", color=(0.8, 0.8, 0.8), emissive=(1.0, 0.9, 0.75), strength=20.0)
+    g.object("lights", lights, lamp)
+    boxes = MeshData(with_uvs=True)
+    cube = unit_cube()
+    state = 12345
+    for k in range(40):  # a fixed linear congruential sequence: the same boxes on every run
+        vals = []
+        for _ in range(3):
+            state = (1103515245 * state + 12345) % 2147483648
+            vals.append(state / 2147483648.0)
+        cx = (vals[0] - 0.5) * 2.0 * (half - 2.0)
+        cz = (vals[1] - 0.5) * 2.0 * (half - 2.0)
+        s = 0.2 + 0.25 * vals[2]
+        base = len(boxes.positions)
+        for p, n, uv in zip(cube.positions, cube.normals, cube.uvs):
+            boxes.vertex((cx + p[0] * s, s / 2.0 + p[1] * s, cz + p[2] * s), n, uv)
+        boxes.indices += [base + i for i in cube.indices]
+    red = g.material("red", color=RED)
+    g.object("boxes", boxes, red)
+    cam_at = (0.0, 2.2, 7.0)
+    g.camera("camera", cam_at, 0.8, aspect=1.0, rotation=look_rotation(sub((0.0, 0.0, 0.0), cam_at)))
+    return g.finish()
+
+
 def far_small_cornell():
     """small_cornell with its whole node tree (camera included) moved by (1e6, -2e6, 5e5): the loader
     rebases it in double, and `caustica info` prints that origin (test scene)."""
@@ -970,6 +1013,7 @@ def main():
         os.path.join(SCENES, "cornell-textured.gltf"): cornell_textured(),
         os.path.join(SCENES, "cornell-dispersion.gltf"): cornell_dispersion(),
         os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
+        os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),
