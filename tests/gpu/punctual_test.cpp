@@ -117,6 +117,41 @@ TEST_CASE("punctual: a point light over a diffuse plane gives albedo / pi * I co
   }
 }
 
+TEST_CASE("punctual: several lights chosen by power sum to the analytic irradiance of all of them") {
+  // Two point lights of very different power, a spot and a sun: the choice by power (binary search over
+  // the cumulative probabilities in the UBO) divided by its probability must add up to the sum.
+  Scene s = planeScene();
+  PunctualLight a, b, spot, sun;
+  a.position = glm::vec3(-0.6f, 0.8f, 0.3f);
+  a.intensity = glm::vec3(0.5f);
+  b.position = glm::vec3(0.7f, 1.5f, -0.4f);
+  b.intensity = glm::vec3(4.0f);
+  spot.type = PunctualType::Spot;
+  spot.position = glm::vec3(0.0f, 1.2f, 0.8f);
+  spot.direction = glm::normalize(glm::vec3(0.0f, -1.0f, -0.5f));
+  spot.intensity = glm::vec3(30.0f);
+  spot.innerCone = 0.2f;
+  spot.outerCone = 0.5f;
+  sun.type = PunctualType::Directional;
+  sun.direction = glm::normalize(glm::vec3(0.4f, -1.0f, 0.1f));
+  sun.intensity = glm::vec3(0.05f);  // power 0.05 pi r^2 = 31 with the plane's bounding radius 14
+  s.punctualLights = {a, b, spot, sun};
+  const auto irradiance = [&](const glm::dvec3& p) {
+    const glm::dvec3 sp(spot.position), sd(spot.direction);
+    const double cosAxis = glm::dot(glm::normalize(p - sp), sd);
+    return pointIrradiance(p, glm::dvec3(a.position), 0.5) + pointIrradiance(p, glm::dvec3(b.position), 4.0) +
+           pointIrradiance(p, sp, 30.0) * spotFalloff(float(cosAxis), std::cos(0.5f), std::cos(0.2f)) +
+           0.05 * double(-sun.direction.y);
+  };
+  RenderResult r = renderScene(s, topCamera(), settings(), 4096, 256);
+  double maxRel = 0.0, meanRel = 0.0;
+  compare(r.image, 0, [&](int x, int y) { return expectedPixel(x, y, irradiance); }, maxRel, meanRel);
+  MESSAGE("four lights: largest block error ", maxRel, ", mean error ", meanRel);
+  // Noise of the light choice at 4096 spp: measured blocks 1.6 %, mean 0.025 %; a 0.5 % bias fails the mean.
+  CHECK(maxRel < 0.04);
+  CHECK(meanRel < 0.003);
+}
+
 TEST_CASE("punctual: a spot light's smooth cone falloff at angles inside, on and outside the cone") {
   Scene s = planeScene();
   PunctualLight l;
