@@ -3,6 +3,7 @@
 // --light-radius spheres converging to the point-light image as the radius shrinks.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 
@@ -265,5 +266,56 @@ TEST_CASE("punctual: --light-radius spheres converge to the point and spot image
     CHECK(errors[1] < 0.015);
     CHECK(meanErrors[1] < 0.004);
     if (type == PunctualType::Spot) CHECK(errors[1] < errors[0]);
+  }
+}
+
+TEST_CASE("punctual: naive and mis agree on --light-radius spheres, spot-shaped emission included") {
+  // naive finds the spheres only by hitting them (emission weighted by the spot's falloff in the hit
+  // direction); mis mostly by light sampling (the same falloff at the sampled point), with MIS weights.
+  Scene s = planeScene();
+  PunctualLight point, spot;
+  point.position = glm::vec3(-1.5f, 0.8f, -0.3f);
+  point.intensity = glm::vec3(1.0f);
+  spot.type = PunctualType::Spot;
+  spot.position = glm::vec3(1.5f, 1.0f, 0.2f);
+  spot.direction = glm::normalize(glm::vec3(-0.8f, -1.0f, 0.0f));
+  spot.intensity = glm::vec3(2.0f);
+  spot.innerCone = 0.2f;
+  spot.outerCone = 0.6f;
+  s.punctualLights = {point, spot};
+  applyLightRadius(s, 0.15f);
+  // Four renders per estimator (other seeds): region means, and their standard errors from the spread.
+  const int h = kSize / 2;
+  const std::vector<std::array<int, 4>> regions = {{0, 0, kSize, kSize}, {0, 0, h, h}, {h, 0, kSize, h}, {0, h, h, kSize}, {h, h, kSize, kSize}};
+  auto regionMeans = [&](Integrator integrator, int spp, std::uint32_t seed) {
+    std::vector<std::vector<double>> per(regions.size());
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      const Image img = renderScene(s, topCamera(), settings(integrator, seed + k), spp, 256).image;
+      for (size_t r = 0; r < regions.size(); ++r) {
+        double sum = 0.0;
+        for (int y = regions[r][1]; y < regions[r][3]; ++y)
+          for (int x = regions[r][0]; x < regions[r][2]; ++x) sum += img.at(x, y, 0);
+        per[r].push_back(sum / ((regions[r][2] - regions[r][0]) * (regions[r][3] - regions[r][1])));
+      }
+    }
+    std::vector<std::pair<double, double>> out;  // mean, variance of the mean
+    for (const auto& v : per) {
+      double m = 0.0, var = 0.0;
+      for (double x : v) m += x / 4.0;
+      for (double x : v) var += (x - m) * (x - m) / 3.0;
+      out.emplace_back(m, var / 4.0);
+    }
+    return out;
+  };
+  const auto naive = regionMeans(Integrator::Naive, 2048, 30), mis = regionMeans(Integrator::Mis, 512, 40);
+  for (size_t r = 0; r < regions.size(); ++r) {
+    const double se = std::sqrt(naive[r].second + mis[r].second);
+    const double z = (naive[r].first - mis[r].first) / se;
+    MESSAGE("region ", r, ": naive ", naive[r].first, " mis ", mis[r].first, ", z = ", z);
+    // Within 4.5 standard errors (estimated from 4 renders each) plus 0.3 % of the mean. Measured with two
+    // seed sets: |z| <= 1.6 except the top right quarter, z = -3.5 and -3.1 (naive 1.5 % low), which
+    // also shows (z = -2.4) with a plain point sphere there: naive's rare hits of a small sphere are
+    // heavy-tailed, so its mean from few samples falls low more often than high.
+    CHECK(std::abs(naive[r].first - mis[r].first) <= 4.5 * se + 0.003 * mis[r].first);
   }
 }
