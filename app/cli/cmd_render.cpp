@@ -55,7 +55,8 @@ int cmdRender(const std::vector<std::string>& args) {
   LoadedScene ls = loadSceneForCli(opts, !quiet);
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
-  const std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
+  std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
+  if (opts.has("--light-radius")) settingsText += "light-radius " + opts.get("--light-radius", "") + "\n";  // changes the scene
   if (resumeFrom) {
     std::string diff = checkpointMismatch(*resumeFrom, sceneHash, settingsText);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);

@@ -100,6 +100,7 @@ class Renderer {
   gpu::PointLights pointLights_{};
   GlBuffer pointLightUbo_;
   std::unique_ptr<RasterRenderer> raster_;  // built the first time the raster mode is used
+  GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
   GlTexture accum_, comp_, display_;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;
