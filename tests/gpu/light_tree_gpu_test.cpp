@@ -100,9 +100,9 @@ void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& node
           ", lightTreePdf ", worstPdf, ", lightImportance ", worstImportance);
   CHECK(sampled > n / 2);
   CHECK(otherChoice <= n / 200);       // measured: 0 (many-lights), 0 (random)
-  CHECK(worstPmf <= 1e-4);             // float rounding over ~10 levels; measured below 1e-5
-  CHECK(worstPdf <= 1e-4);
-  CHECK(worstImportance <= 1e-4);
+  CHECK(worstPmf <= 1e-4);             // float rounding over ~10-20 levels; measured 2.4e-5
+  CHECK(worstPdf <= 1e-4);             // measured 2.7e-5
+  CHECK(worstImportance <= 1e-4);      // measured 4.0e-5
 }
 
 }  // namespace
