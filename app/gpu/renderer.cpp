@@ -12,22 +12,51 @@
 
 namespace caustica {
 
-gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const Bounds& bounds) {
+gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const std::vector<PunctualLight>& punctual,
+                                  const Bounds& bounds) {
   gpu::PointLights pl{};
-  pl.count.x = static_cast<std::uint32_t>(std::min<size_t>(groups.size(), CAUSTICA_MAX_POINT_LIGHTS));
-  for (std::uint32_t i = 0; i < pl.count.x; ++i) {
-    const LightGroup& g = groups[i];
+  // Distance from a light to the farthest corner of the scene: the shadow maps' far plane.
+  auto farthest = [&](const glm::vec3& p) {
     float far = 0.0f;
     if (!bounds.empty())
       for (int c = 0; c < 8; ++c) {
         glm::vec3 corner((c & 1) ? bounds.max.x : bounds.min.x, (c & 2) ? bounds.max.y : bounds.min.y,
                          (c & 4) ? bounds.max.z : bounds.min.z);
-        far = std::max(far, glm::length(corner - g.position));
+        far = std::max(far, glm::length(corner - p));
       }
-    pl.light[i].position = glm::vec4(g.position, g.isotropic);
-    pl.light[i].intensity = glm::vec4(g.intensity, std::max(far * 1.01f, 1e-6f));
-    pl.light[i].axis = glm::vec4(g.axis, 0.0f);
+    return std::max(far * 1.01f, 1e-6f);
+  };
+  std::uint32_t n = 0;
+  for (const LightGroup& g : groups) {
+    if (n == CAUSTICA_MAX_POINT_LIGHTS) break;
+    gpu::PointLight& l = pl.light[n++];
+    l.position = glm::vec4(g.position, g.isotropic);
+    l.intensity = glm::vec4(g.intensity, farthest(g.position));
+    l.axis = glm::vec4(g.axis, 0.0f);
   }
+  // KHR_lights_punctual lights take the slots the emitter groups leave (most powerful first as listed).
+  // A directional light becomes a point light far away (100 scene radii) whose intensity gives the
+  // light's irradiance at the scene's centre.
+  const glm::vec3 centre = bounds.empty() ? glm::vec3(0.0f) : (bounds.min + bounds.max) * 0.5f;
+  const float radius = bounds.empty() ? 1.0f : std::max(glm::length(bounds.max - bounds.min) * 0.5f, 1e-6f);
+  for (const PunctualLight& p : punctual) {
+    if (n == CAUSTICA_MAX_POINT_LIGHTS) break;
+    gpu::PointLight& l = pl.light[n++];
+    glm::vec3 pos = p.position, intensity = p.intensity;
+    if (p.type == PunctualType::Directional) {
+      float d = 100.0f * radius;
+      pos = centre - p.direction * d;
+      intensity *= d * d;
+    }
+    l.position = glm::vec4(pos, 1.0f);  // isotropic
+    l.intensity = glm::vec4(intensity, farthest(pos));
+    if (p.type == PunctualType::Spot) {
+      l.position.w = 0.0f;
+      l.axis = glm::vec4(p.direction, 0.0f);
+      l.cone = glm::vec4(std::cos(p.outerCone), std::cos(p.innerCone), 1.0f, 0.0f);
+    }
+  }
+  pl.count.x = n;
   return pl;
 }
 
@@ -75,7 +104,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     sceneBounds.grow(g.nodes[0].bmin);
     sceneBounds.grow(g.nodes[0].bmax);
   }
-  pointLights_ = pointLightParams(lightGroups_, sceneBounds);
+  pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
   allocateImages();
   prepareMode();  // compile now, so shader errors surface before rendering starts

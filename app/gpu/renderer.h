@@ -22,9 +22,11 @@ namespace caustica {
 
 class RasterRenderer;
 
-// The PointLights UBO of the raster and Whitted modes for `groups` (at most CAUSTICA_MAX_POINT_LIGHTS),
-// with each light's shadow far distance reaching the farthest corner of `bounds`.
-gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const Bounds& bounds);
+// The PointLights UBO of the raster and Whitted modes: the emitter `groups`, then the scene's punctual
+// lights (at most CAUSTICA_MAX_POINT_LIGHTS in all), with each light's shadow far distance reaching the
+// farthest corner of `bounds`.
+gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const std::vector<PunctualLight>& punctual,
+                                  const Bounds& bounds);
 
 // Totals over everything rendered since the last reset.
 struct RenderStats {

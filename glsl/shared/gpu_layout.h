@@ -144,11 +144,15 @@ struct CasterParams {
 // The raster and Whitted modes light the scene with point lights: the emissive triangles grouped
 // into at most CAUSTICA_MAX_POINT_LIGHTS lights at their power-weighted centres (app/scene/light_groups.h).
 // Radiant intensity towards unit direction w (from the light): intensity.rgb * (max(0, dot(axis.xyz, w)) + position.w),
-// so a flat one-sided emitter keeps its cosine lobe and a closed one shines evenly (std140).
+// so a flat one-sided emitter keeps its cosine lobe and a closed one shines evenly; a spot light
+// (cone.z = 1) gives intensity.rgb * spotFalloff(dot(axis.xyz, w), cone.x, cone.y) instead (std140).
+// KHR_lights_punctual lights join the groups: point (axis 0, position.w 1), spot, and directional
+// (a point far away, docs/render-modes.md).
 struct PointLight {
   vec4 position;   // xyz: world-space position; w: isotropic part of the lobe (0 flat .. 1/4 closed)
   vec4 intensity;  // rgb: sum of emitted radiance * area (* 2 if double-sided); w: shadow far distance (scene units)
-  vec4 axis;       // xyz: mean emitter normal, length = the flat part of the lobe (0..1); w: unused
+  vec4 axis;       // xyz: mean emitter normal, length = the flat part of the lobe (0..1); spot: unit cone axis; w: unused
+  vec4 cone;       // spot only: x: cos(outer cone), y: cos(inner cone), z: 1 (else 0); w: unused
 };
 struct PointLights {
   uvec4 count;                                  // x: lights in use (0..CAUSTICA_MAX_POINT_LIGHTS); yzw unused
@@ -170,8 +174,8 @@ struct PunctualParams {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(PointLight) == 48, "PointLight must be 48 bytes (std140)");
-static_assert(sizeof(PointLights) == 16 + 48 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
+static_assert(sizeof(PointLight) == 64, "PointLight must be 64 bytes (std140)");
+static_assert(sizeof(PointLights) == 16 + 64 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
 static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
