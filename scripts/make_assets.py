@@ -443,7 +443,9 @@ class Gltf:
 
     def material(self, name, color=(0.8, 0.8, 0.8), alpha=1.0, metallic=0.0, roughness=1.0,
                  emissive=None, strength=1.0, transmission=0.0, ior=None, thickness=None,
-                 dispersion=None, double_sided=False, base_texture=None):
+                 dispersion=None, double_sided=False, base_texture=None, specular=0.0):
+        """specular: KHR_materials_specular's specularFactor of the dielectric layer over the diffuse
+        base. The shipped Cornell scenes are Lambertian (0, written out); glTF's default is 1."""
         pbr = {"baseColorFactor": [clean(c) for c in color] + [clean(alpha)],
                "metallicFactor": clean(metallic), "roughnessFactor": clean(roughness)}
         if base_texture is not None:
@@ -464,6 +466,8 @@ class Gltf:
             ext["KHR_materials_volume"] = {"thicknessFactor": clean(thickness)}
         if dispersion is not None:
             ext["KHR_materials_dispersion"] = {"dispersion": clean(dispersion)}
+        if specular != 1.0 and metallic < 1.0 and transmission < 1.0:
+            ext["KHR_materials_specular"] = {"specularFactor": clean(specular)}
         if ext:
             mat["extensions"] = ext
             self.extensions.update(ext.keys())

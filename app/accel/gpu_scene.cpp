@@ -2,9 +2,11 @@
 #include "accel/gpu_scene.h"
 
 #include <cmath>
+#include <cstring>
 
 #include "scene/caustic_casters.h"
 #include "util/error.h"
+#include "shading/microfacet.h"
 #include "shading/sampling.h"
 
 namespace caustica {
@@ -17,6 +19,7 @@ std::vector<std::string> SceneFeatures::defines() const {
   if (dispersion) d.push_back("CAUSTICA_DISPERSION");
   if (textures) d.push_back("CAUSTICA_TEXTURES");
   if (opacity) d.push_back("CAUSTICA_OPACITY");
+  if (ggx) d.push_back("CAUSTICA_GGX");
   return d;
 }
 
@@ -31,7 +34,16 @@ std::string SceneFeatures::describe() const {
   add(dispersion, "dispersion");
   add(textures, "textures");
   add(opacity, "opacity");
+  add(ggx, "ggx");
   return s.empty() ? "diffuse only" : s;
+}
+
+bool hasRoughLobe(const Material& m) {
+  const bool rough = m.roughness * m.roughness >= kDeltaAlpha || m.metallicRoughnessTexture >= 0;
+  const bool metal = m.metallic > 0.0f || m.metallicRoughnessTexture >= 0;
+  const bool glass = m.transmission > 0.0f && m.metallic < 1.0f;
+  const bool layered = m.metallic < 1.0f && m.transmission < 1.0f && m.specularF90 > 0.0f;
+  return (rough && (metal || glass)) || layered;
 }
 
 SceneFeatures sceneFeatures(const Scene& scene) {
@@ -48,8 +60,10 @@ SceneFeatures sceneFeatures(const Scene& scene) {
     f.volume |= glass && std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f &&
                 glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
     f.dispersion |= glass && m.dispersion > 0.0f;
-    f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
-    f.opacity |= m.baseColor.a < 1.0f;
+    f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0 || m.metallicRoughnessTexture >= 0 ||
+                  m.normalTexture >= 0;
+    f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture;
+    f.ggx |= hasRoughLobe(m);
   }
   return f;
 }
@@ -87,6 +101,14 @@ std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, co
   return table;
 }
 
+namespace {
+std::uint32_t floatBits(float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+}  // namespace
+
 GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   GpuScene g;
   g.features = sceneFeatures(scene);
@@ -121,6 +143,12 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
     gm.tex = glm::uvec4(m.baseColorTexture >= 0 ? static_cast<std::uint32_t>(m.baseColorTexture) : gpu::kInvalidIndex,
                         m.emissiveTexture >= 0 ? static_cast<std::uint32_t>(m.emissiveTexture) : gpu::kInvalidIndex,
                         flags, 0u);
+    const auto texIndex = [](int t) { return t >= 0 ? static_cast<std::uint32_t>(t) : gpu::kInvalidIndex; };
+    if (m.alphaFromTexture) gm.tex.z |= gpu::kMatAlphaTexture;
+    if (m.alphaFromTexture && m.alphaCutoff >= 0.0f) gm.tex.z |= gpu::kMatAlphaMask;
+    gm.specular = glm::vec4(m.specularF0, m.specularF90);
+    gm.tex2 = glm::uvec4(texIndex(m.metallicRoughnessTexture), texIndex(m.normalTexture),
+                         floatBits(m.normalScale), floatBits(m.alphaCutoff));
     g.materials.push_back(gm);
   }
 

@@ -20,7 +20,7 @@ using Json = nlohmann::json;
 
 const char* const kSupportedExtensions[] = {
     "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
-    "KHR_materials_dispersion", "KHR_materials_emissive_strength"};
+    "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_materials_specular"};
 
 std::string supportedExtensionList() {
   std::string out;
@@ -458,6 +458,13 @@ class JsonChecker {
       number(*e, vat, "attenuationDistance");
       numbers(*e, vat, "attenuationColor", 3);
       textureInfo(*e, vat, "thicknessTexture");
+    }
+    if (const Json* e = object(*ext, eat, "KHR_materials_specular")) {
+      const std::string sat = join(eat, "KHR_materials_specular");
+      number(*e, sat, "specularFactor");
+      numbers(*e, sat, "specularColorFactor", 3);
+      textureInfo(*e, sat, "specularTexture");
+      textureInfo(*e, sat, "specularColorTexture");
     }
     if (const Json* e = object(*ext, eat, "KHR_materials_dispersion"))
       number(*e, join(eat, "KHR_materials_dispersion"), "dispersion");

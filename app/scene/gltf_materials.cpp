@@ -90,17 +90,24 @@ Material SceneBuilder::convertMaterial(int index) {
   out.metallic = float(unit(pbr.metallicFactor, at + ".metallicFactor"));
   out.roughness = float(unit(pbr.roughnessFactor, at + ".roughnessFactor"));
   out.baseColorTexture = texture(pbr.baseColorTexture, at + ".baseColorTexture");
+  out.metallicRoughnessTexture = texture(pbr.metallicRoughnessTexture, at + ".metallicRoughnessTexture");
+  out.normalTexture = texture(m.normalTexture, at + ".normalTexture");
+  out.normalScale = float(m.normalTexture.scale);
+  if (!std::isfinite(out.normalScale)) fail(at + ".normalTexture.scale is not finite");
 
-  // Opacity: OPAQUE ignores alpha, MASK thresholds the factor, BLEND keeps it. Texture alpha is
-  // not used (docs/materials.md).
+  // Opacity: OPAQUE ignores alpha; MASK thresholds factor x texture alpha at alphaCutoff; BLEND keeps
+  // it as partial opacity (docs/materials.md). Without a texture the threshold is applied here.
   if (m.alphaMode == "OPAQUE" || m.alphaMode.empty()) {
     base.a = 1.0;
   } else if (m.alphaMode == "MASK") {
-    base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
+    if (!(m.alphaCutoff >= 0.0)) fail(at + ".alphaCutoff is " + num(m.alphaCutoff) + "; it must be >= 0");
+    if (out.baseColorTexture >= 0) out.alphaCutoff = float(m.alphaCutoff);
+    else base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
   } else if (m.alphaMode != "BLEND") {
     fail(at + ".alphaMode is \"" + oneLine(m.alphaMode) + "\"; it must be OPAQUE, BLEND or MASK");
   }
   out.baseColor = glm::vec4(base);
+  out.alphaFromTexture = out.baseColorTexture >= 0 && (m.alphaMode == "BLEND" || m.alphaMode == "MASK");
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength = radiance (linear).
   glm::dvec3 emissive(0.0);
@@ -126,9 +133,7 @@ Material SceneBuilder::convertMaterial(int index) {
   const auto ignore = [&](bool present, const char* what) {
     if (present) ignored += (ignored.empty() ? "" : ", ") + std::string(what);
   };
-  ignore(pbr.metallicRoughnessTexture.index >= 0, "metallicRoughnessTexture");
-  ignore(m.normalTexture.index >= 0, "normalTexture");
-  ignore(m.occlusionTexture.index >= 0, "occlusionTexture");
+  ignore(m.occlusionTexture.index >= 0, "occlusionTexture (ambient occlusion is what a path tracer computes)");
 
   if (const tinygltf::Value* t = extension(m.extensions, "KHR_materials_transmission")) {
     out.transmission = float(unit(extNumber(t, "transmissionFactor", 0.0), at + ".transmissionFactor"));
@@ -150,15 +155,37 @@ Material SceneBuilder::convertMaterial(int index) {
     if (!(distance > 0.0)) warn(at + ": attenuationDistance " + num(distance) + " is not positive; no absorption");
     else out.attenuationDistance = float(distance);
   }
+  // The dielectric specular layer over the diffuse base (glTF Appendix B fresnel_mix, with
+  // KHR_materials_specular): F0 = min(((ior - 1) / (ior + 1))^2 specularColorFactor, 1) specularFactor,
+  // F90 = specularFactor.
+  {
+    double specularFactor = 1.0;
+    glm::dvec3 specularColor(1.0);
+    if (const tinygltf::Value* sp = extension(m.extensions, "KHR_materials_specular")) {
+      specularFactor = unit(extNumber(sp, "specularFactor", 1.0), at + ".specularFactor");
+      if (extHas(sp, "specularColorFactor") && sp->Get("specularColorFactor").ArrayLen() == 3)
+        for (int c = 0; c < 3; ++c) {
+          const tinygltf::Value& v = sp->Get("specularColorFactor").Get(c);
+          double x = v.IsNumber() ? v.GetNumberAsDouble() : 1.0;
+          if (!(x >= 0.0) || !std::isfinite(x)) {
+            warn(at + ".specularColorFactor[" + str(std::uint64_t(c)) + "] is not a finite number >= 0; using 1");
+            x = 1.0;
+          }
+          specularColor[c] = x;
+        }
+      ignore(extHas(sp, "specularTexture"), "specularTexture");
+      ignore(extHas(sp, "specularColorTexture"), "specularColorTexture");
+    }
+    const double r = (double(out.ior) - 1.0) / (double(out.ior) + 1.0);
+    out.specularF0 = glm::vec3(glm::min(r * r * specularColor, glm::dvec3(1.0)) * specularFactor);
+    out.specularF90 = float(specularFactor);
+  }
   if (const tinygltf::Value* d = extension(m.extensions, "KHR_materials_dispersion")) {
     const double dispersion = extNumber(d, "dispersion", 0.0);
     if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
     else out.dispersion = float(dispersion);
   }
   if (!ignored.empty()) warn(at + " '" + oneLine(out.name) + "': ignoring unsupported " + ignored);
-  if (out.roughness > 0.0f && (out.metallic > 0.0f || out.transmission > 0.0f))
-    warn(at + " '" + oneLine(out.name) + "': roughness " + num(out.roughness) +
-         " on a mirror/glass component is rendered as perfectly smooth (rough lobes are not implemented)");
   return out;
 }
 
