@@ -585,6 +585,27 @@ def cornell_glass(segments=64, rings=32):
     return g.finish()
 
 
+def cornell_materials(segments=48, rings=24):
+    """glTF metallic-roughness under two area lights: a rough gold metal sphere, a red plastic sphere
+    (GGX specular layer over a diffuse base, glTF's default specular) and a frosted glass sphere."""
+    g = Gltf()
+    add_cornell_box(g)
+    add_ceiling_light(g, 0.4, 0.3, x=-0.35)
+    add_ceiling_light(g, 0.4, 0.3, x=0.35)
+    radius = 0.3
+    gold = g.material("rough gold", color=(1.0, 0.766, 0.336), metallic=1.0, roughness=0.35)
+    plastic = g.material("red plastic", color=(0.6, 0.05, 0.04), roughness=0.25, specular=1.0)
+    frosted = g.material("frosted glass", color=(1.0, 1.0, 1.0), roughness=0.3, transmission=1.0, ior=1.5,
+                         thickness=2 * radius)
+    prim = g.primitive(uv_sphere(radius, segments, rings), gold)
+    for name, material, position in (("gold sphere", gold, (-0.5, radius, -0.3)),
+                                     ("plastic sphere", plastic, (0.5, radius, -0.2)),
+                                     ("frosted sphere", frosted, (0.0, radius, 0.35))):
+        g.node(name, mesh=g.mesh(name, [dict(prim, material=material)]), translation=position)
+    g.camera("camera", **CORNELL_CAMERA)
+    return g.finish()
+
+
 def cornell_bunny_light():
     mesh, area = bunny(0.6)
     g = Gltf(copyright=BUNNY_CREDIT)
@@ -912,6 +933,7 @@ def main():
         os.path.join(SCENES, "cornell-bunny-light.gltf"): cornell_bunny_light(),
         os.path.join(SCENES, "cornell-textured.gltf"): cornell_textured(),
         os.path.join(SCENES, "cornell-dispersion.gltf"): cornell_dispersion(),
+        os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),

@@ -134,6 +134,7 @@ class SceneBuilder {
   double unit(double v, const std::string& what);
   Material convertMaterial(int index);
   int texture(const tinygltf::TextureInfo& info, const std::string& at);
+  int texture(const tinygltf::NormalTextureInfo& info, const std::string& at);
   std::uint32_t defaultMaterial(const std::string& at);
 
   // ---- node hierarchy (gltf_nodes.cpp) ----

@@ -240,6 +240,14 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
   return result;
 }
 
+int SceneBuilder::texture(const tinygltf::NormalTextureInfo& info, const std::string& at) {
+  tinygltf::TextureInfo t;
+  t.index = info.index;
+  t.texCoord = info.texCoord;
+  t.extensions = info.extensions;
+  return texture(t, at);
+}
+
 std::uint32_t SceneBuilder::defaultMaterial(const std::string& at) {
   if (defaultMaterial_ < 0) {
     Material m;

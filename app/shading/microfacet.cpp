@@ -53,9 +53,10 @@ glm::vec3 ggxSampleVisibleNormal(const glm::vec3& wo, float alpha, const glm::ve
   // Stretch to the unit-roughness configuration, sample the spherical cap of visible normals, unstretch.
   glm::vec3 ws = glm::normalize(glm::vec3(wo.x * alpha, wo.y * alpha, wo.z));
   float phi = 2.0f * kPi * u.x;
-  float z = (1.0f - u.y) * (1.0f + ws.z) - ws.z;
+  float hz = (1.0f - u.y) * (1.0f + ws.z);  // z + ws.z, without the cancellation of the sum near the cap's edge
+  float z = hz - ws.z;
   float sinTheta = std::sqrt(glm::clamp(1.0f - z * z, 0.0f, 1.0f));
-  glm::vec3 h = glm::vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), z) + ws;
+  glm::vec3 h(sinTheta * std::cos(phi) + ws.x, sinTheta * std::sin(phi) + ws.y, hz);
   h = glm::vec3(h.x * alpha, h.y * alpha, std::max(h.z, 0.0f));
   float len = glm::length(h);
   return len > 0.0f ? h / len : glm::vec3(0.0f, 0.0f, 1.0f);

@@ -70,6 +70,8 @@ bool isEmissive(Material m) { return maxComponent(m.emission.rgb) > 0.0; }
 // metal: the metallic value at the hit (materialMetalRough). With CAUSTICA_GGX a metal or glass with
 // GGX alpha = roughness^2 >= kDeltaAlpha takes its rough lobe, and a diffuse part with a specular
 // layer (F90 > 0) the plastic lobe; otherwise the delta lobes and the Lambertian lobe as before.
+// (Glass of ior 1 stays the delta lobe: it passes light straight through, and the generalised half
+// vector of rough refraction does not exist there.)
 uint chooseLobe(Material m, float metal, float roughness, float u) {
   float trans = 0.0;
 #ifndef CAUSTICA_MIRROR
@@ -84,7 +86,7 @@ uint chooseLobe(Material m, float metal, float roughness, float u) {
 #ifdef CAUSTICA_GGX
   bool rough = roughness * roughness >= kDeltaAlpha;
   if (lobe == kLobeMirror && rough) lobe = kLobeConductor;
-  else if (lobe == kLobeGlass && rough) lobe = kLobeRoughGlass;
+  else if (lobe == kLobeGlass && rough && m.params.w != 1.0) lobe = kLobeRoughGlass;  // ior 1: no interface
   else if (lobe == kLobeDiffuse && m.specular.w > 0.0) lobe = kLobePlastic;
 #endif
   return lobe;

@@ -55,9 +55,10 @@ float ggxG2(vec3 wo, vec3 wi, float alpha) {
 vec3 ggxSampleVisibleNormal(vec3 wo, float alpha, vec2 u) {
   vec3 ws = normalize(vec3(wo.x * alpha, wo.y * alpha, wo.z));
   float phi = 2.0 * PI * u.x;
-  float z = (1.0 - u.y) * (1.0 + ws.z) - ws.z;
+  float hz = (1.0 - u.y) * (1.0 + ws.z);  // z + ws.z, without the cancellation of the sum near the cap's edge
+  float z = hz - ws.z;
   float sinTheta = sqrt(clamp(1.0 - z * z, 0.0, 1.0));
-  vec3 h = vec3(sinTheta * cos(phi), sinTheta * sin(phi), z) + ws;
+  vec3 h = vec3(sinTheta * cos(phi) + ws.x, sinTheta * sin(phi) + ws.y, hz);
   h = vec3(h.x * alpha, h.y * alpha, max(h.z, 0.0));
   float len = length(h);
   return len > 0.0 ? h / len : vec3(0.0, 0.0, 1.0);

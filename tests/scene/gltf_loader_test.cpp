@@ -572,10 +572,16 @@ TEST_CASE("material contract: alpha modes, emission strength, glass extensions, 
               {"KHR_materials_dispersion", {{"dispersion", 0.5}}}}}});
   material({{"name", "rough mirror"}, {"pbrMetallicRoughness", {{"metallicFactor", 0.6}, {"roughnessFactor", 0.4}}}});
   material({{"name", "spec default"}});
+  material({{"name", "plastic"},
+            {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.3}}},
+            {"extensions",
+             {{"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {1.0, 0.5, 0.25}}}},
+              {"KHR_materials_ior", {{"ior", 2.0}}}}}});
   g.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
-                             "KHR_materials_volume", "KHR_materials_dispersion", "EXT_something_else"};
+                             "KHR_materials_volume", "KHR_materials_dispersion", "KHR_materials_specular",
+                             "EXT_something_else"};
   const Scene s = g.load(dir);
-  REQUIRE(s.materials.size() == 8);
+  REQUIRE(s.materials.size() == 9);
   CHECK(findMaterial(s, "opaque")->baseColor.a == 1.0f);
   CHECK(findMaterial(s, "opaque")->baseColor.b == doctest::Approx(0.6));
   CHECK(findMaterial(s, "blend")->baseColor.a == doctest::Approx(0.3));
@@ -600,8 +606,20 @@ TEST_CASE("material contract: alpha modes, emission strength, glass extensions, 
   CHECK(spec->roughness == 1.0f);
   CHECK(spec->ior == doctest::Approx(1.5));
   CHECK(std::isinf(spec->attenuationDistance));
-  CHECK(hasWarning(s, "'rough mirror'"));
-  CHECK(hasWarning(s, "'spec default'"));
+  // Roughness is rendered (GGX), so it is no longer warned about.
+  CHECK(!hasWarning(s, "'rough mirror'"));
+  CHECK(!hasWarning(s, "'spec default'"));
+  CHECK(findMaterial(s, "rough mirror")->roughness == doctest::Approx(0.4));
+  // The specular layer: glTF's F0 = ((ior - 1) / (ior + 1))^2 = 0.04 at ior 1.5 and F90 = 1 by default;
+  // KHR_materials_specular scales F0 by specularColorFactor x specularFactor and F90 by specularFactor.
+  CHECK(spec->specularF0.g == doctest::Approx(0.04));
+  CHECK(spec->specularF90 == 1.0f);
+  const auto* plastic = findMaterial(s, "plastic");
+  CHECK(plastic->specularF0.r == doctest::Approx(0.5 / 9.0));  // ((2 - 1) / (2 + 1))^2 = 1/9
+  CHECK(plastic->specularF0.g == doctest::Approx(0.25 / 9.0));
+  CHECK(plastic->specularF0.b == doctest::Approx(0.125 / 9.0));
+  CHECK(plastic->specularF90 == doctest::Approx(0.5));
+  CHECK(!hasWarning(s, "'plastic'"));
   CHECK(!hasWarning(s, "'tinted glass'"));
   CHECK(hasWarning(s, "EXT_something_else"));
   for (const auto& w : s.warnings) CHECK(w.rfind(s.path + ": ", 0) == 0);

@@ -109,7 +109,7 @@ double ggxAlbedoQuadrature(double cosO, double alpha) {
     double ch = 1.0 / std::sqrt(1.0 + tan2), sh = std::sqrt(tan2) * ch;
     for (int b = 0; b < nPhi; ++b) {
       double phi = 2 * kPiD * (b + 0.5) / nPhi;
-      double hx = sh * std::cos(phi), hy = sh * std::sin(phi), hz = ch;
+      double hx = sh * std::cos(phi), hz = ch;  // h_y does not enter: wo lies in the xz plane
       double oh = sinO * hx + cosO * hz;  // wo = (sinO, 0, cosO)
       if (oh <= 0) continue;
       double iz = 2 * oh * hz - cosO;  // wi = 2 (wo.h) h - wo
@@ -191,8 +191,11 @@ TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe") {
       }
 }
 
-TEST_CASE("bsdfEval is reciprocal: f(wo, wi) = f(wi, wo); refraction: f(wo, wi) / eta_i^2 = f(wi, wo) / eta_o^2") {
+// With radiance divided by eta^2 on refraction, f(wo, wi) / n_o^2 = f(wi, wo) / n_i^2 (Veach's
+// generalised reciprocity), n_o and n_i the indices on wo's and wi's sides.
+TEST_CASE("bsdfEval is reciprocal: f(wo, wi) = f(wi, wo); refraction: f(wo, wi) / n_o^2 = f(wi, wo) / n_i^2") {
   RngState rng = rngSeed(5, 5, 5);
+  int refracting = 0, pairs = 0;
   for (int k = 0; k < 2000; ++k) {
     glm::vec3 a = sampleCosineHemisphere({rand01(rng), rand01(rng)});
     glm::vec3 c = sampleCosineHemisphere({rand01(rng), rand01(rng)});
@@ -218,8 +221,11 @@ TEST_CASE("bsdfEval is reciprocal: f(wo, wi) = f(wi, wo); refraction: f(wo, wi) 
     float fIn = bsdfEval(in, a, below).x;  // wo outside, wi inside (light comes from inside)
     // The reverse path in its own frame: wo' = -below flipped to +z, wi' = a flipped to -z.
     float fOut = bsdfEval(out, -below, -a).x;
-    CHECK(std::abs(fIn / (1.5f * 1.5f) - fOut / 1.0f) <= 2e-4f * (1.0f + fIn));
+    CHECK(std::abs(fIn / 1.0f - fOut / (1.5f * 1.5f)) <= 2e-4f * (1.0f + fIn));
+    refracting += fIn > 0.0f;  // 0 where no microfacet refracts a into below (both behind it)
+    ++pairs;
   }
+  CHECK(refracting * 4 > pairs);  // the refraction check saw many non-zero values (measured: a third)
 }
 
 TEST_CASE("furnace: a rough metal with F0 = 1 reflects its GGX directional albedo (sampling vs quadrature)") {
@@ -248,32 +254,44 @@ TEST_CASE("furnace: a rough metal with F0 = 1 reflects its GGX directional albed
       CAPTURE(alpha);
       CAPTURE(cosO);
       CHECK(quad <= 1.0 + 1e-4);
+      // At alpha = 1 and normal incidence: D = 1/pi, G1 = 2 cos / (1 + cos), E = 1 - ln 2 exactly.
+      if (alpha == 1.0f && cosO == 1.0f) CHECK(std::abs(quad - (1.0 - std::log(2.0))) < 2e-5);
       CHECK(std::abs(mean - quad) < 4.0 * sigma + 2e-4);
     }
 }
 
-TEST_CASE("energy: plastic and rough glass never reflect more than they receive") {
+// Rough glass (reflection plus refraction, transmitted flux counted without the radiance's 1 / eta^2)
+// never returns more than it receives. glTF's fresnel_mix (plastic) weights the diffuse base by
+// 1 - F(wo.h) with h the half vector of wo and wi: at grazing wo over a white base that overshoots
+// (measured below: up to 1.44 at alpha 0.05, cos 0.05), a property of glTF's model, printed for
+// docs/materials.md and bounded here so that a change shows.
+TEST_CASE("energy: rough glass never returns more than it receives; the plastic lobe's albedo") {
   RngState rng = rngSeed(8, 8, 8);
-  for (std::uint32_t lobe : {kLobePlastic, kLobeRoughGlass})
+  for (std::uint32_t lobe : {kLobeRoughGlass, kLobePlastic})
     for (float alpha : {0.05f, 0.5f, 1.0f})
-      for (float cosO : {1.0f, 0.3f, 0.05f}) {
-        Bsdf b;
-        b.lobe = lobe;
-        b.alpha = alpha;
-        b.color = glm::vec3(1.0f);
-        b.f0 = glm::vec3(0.04f);
-        const int n = 100000;
-        double sum = 0;
-        for (int k = 0; k < n; ++k) {
-          BsdfSample s;
-          if (!bsdfSample(b, unitWo(cosO), {rand01(rng), rand01(rng), rand01(rng)}, s)) continue;
-          // Transmitted radiance is divided by eta^2; energy (flux) is not.
-          sum += s.weight.x * (s.transmitted ? b.eta * b.eta : 1.0f);
+      for (float cosO : {1.0f, 0.3f, 0.05f})
+        for (float eta : {1.5f, 1.0f / 1.5f}) {
+          if (lobe == kLobePlastic && eta != 1.5f) continue;
+          Bsdf b;
+          b.lobe = lobe;
+          b.alpha = alpha;
+          b.eta = eta;
+          b.color = glm::vec3(1.0f);
+          b.f0 = glm::vec3(0.04f);
+          const int n = 100000;
+          double sum = 0;
+          for (int k = 0; k < n; ++k) {
+            BsdfSample s;
+            if (!bsdfSample(b, unitWo(cosO), {rand01(rng), rand01(rng), rand01(rng)}, s)) continue;
+            sum += s.weight.x * (s.transmitted ? b.eta * b.eta : 1.0f);
+          }
+          CAPTURE(lobe);
+          CAPTURE(alpha);
+          CAPTURE(cosO);
+          CAPTURE(eta);
+          if (lobe == kLobePlastic)
+            std::printf("plastic albedo (white base, F0 0.04) alpha %.2f cos %.2f: %.4f\n", alpha, cosO, sum / n);
+          CHECK(sum / n <= (lobe == kLobePlastic ? 1.5 : 1.0) + 4.0 / std::sqrt(double(n)));
+          CHECK(sum / n > 0.3);
         }
-        CAPTURE(lobe);
-        CAPTURE(alpha);
-        CAPTURE(cosO);
-        CHECK(sum / n <= 1.0 + 4.0 / std::sqrt(double(n)));
-        CHECK(sum / n > 0.5);
-      }
 }
