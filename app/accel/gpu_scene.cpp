@@ -155,6 +155,12 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   for (const Texture& t : scene.textures) {
     gpu::TexInfo info{};
     info.offset = static_cast<std::uint32_t>(g.texels.size());
+    if (t.pixelSource >= 0) {  // a transformed reference: the texels of an earlier entry
+      if (std::size_t(t.pixelSource) >= g.texInfo.size()) throw Error("internal: texture pixel source out of order");
+      info.offset = g.texInfo[std::size_t(t.pixelSource)].offset;
+    }
+    info.uvRow0 = glm::vec4(t.uvRow0, 0.0f);
+    info.uvRow1 = glm::vec4(t.uvRow1, 0.0f);
     info.width = static_cast<std::uint32_t>(t.width);
     info.height = static_cast<std::uint32_t>(t.height);
     info.flags = (t.repeatS ? 1u : 0u) | (t.repeatT ? 2u : 0u) | (t.mirrorS ? 4u : 0u) | (t.mirrorT ? 8u : 0u) |

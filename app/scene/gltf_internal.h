@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -173,6 +174,8 @@ class SceneBuilder {
   const LoadOptions& options_;
   Scene& scene_;
   std::map<int, int> textureMap_;  // glTF texture index -> Scene::textures index (-1: ignored)
+  // Transformed references (KHR_texture_transform): glTF texture index and rows -> Scene::textures index.
+  std::map<std::pair<int, std::vector<float>>, int> transformMap_;
   int defaultMaterial_ = -1;
   std::size_t degenerate_ = 0;   // zero-area triangles dropped
   std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable

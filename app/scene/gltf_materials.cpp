@@ -194,9 +194,49 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
   if (std::size_t(info.index) >= model_.textures.size())
     fail(at + ".index is " + str(std::uint64_t(info.index)) + ", but the file has " + str(model_.textures.size()) +
          " textures");
-  if (info.texCoord != 0)
-    warn(at + " uses TEXCOORD_" + str(std::uint64_t(info.texCoord)) + "; only TEXCOORD_0 is loaded and used instead");
-  if (info.extensions.count("KHR_texture_transform")) warn(at + ": KHR_texture_transform is not supported; ignored");
+  int texCoord = info.texCoord;
+  // KHR_texture_transform (the ratified form, whose example maps rotation pi/2, offset (0, 1), scale
+  // 0.5 to the lower left quadrant): u' = c sx u + s sy v + ox, v' = -s sx u + c sy v + oy.
+  glm::dvec3 row0(1.0, 0.0, 0.0), row1(0.0, 1.0, 0.0);
+  if (const tinygltf::Value* t = extension(info.extensions, "KHR_texture_transform")) {
+    const auto pair = [&](const char* key, glm::dvec2 fallback) {
+      if (!t->Has(key) || t->Get(key).ArrayLen() != 2) return fallback;
+      glm::dvec2 v;
+      for (int c = 0; c < 2; ++c) v[c] = t->Get(key).Get(c).IsNumber() ? t->Get(key).Get(c).GetNumberAsDouble() : fallback[c];
+      return v;
+    };
+    const glm::dvec2 offset = pair("offset", glm::dvec2(0.0)), scale = pair("scale", glm::dvec2(1.0));
+    const double rotation = extNumber(t, "rotation", 0.0);
+    if (!std::isfinite(offset.x) || !std::isfinite(offset.y) || !std::isfinite(scale.x) || !std::isfinite(scale.y) ||
+        !std::isfinite(rotation))
+      fail(at + ".extensions.KHR_texture_transform has a number that is not finite");
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    row0 = glm::dvec3(c * scale.x, s * scale.y, offset.x);
+    row1 = glm::dvec3(-s * scale.x, c * scale.y, offset.y);
+    if (t->Has("texCoord") && t->Get("texCoord").IsInt()) texCoord = t->Get("texCoord").GetNumberAsInt();
+  }
+  if (texCoord != 0)
+    warn(at + " uses TEXCOORD_" + str(std::uint64_t(std::max(texCoord, 0))) +
+         "; only TEXCOORD_0 is loaded and used instead");
+  if (row0 != glm::dvec3(1.0, 0.0, 0.0) || row1 != glm::dvec3(0.0, 1.0, 0.0)) {
+    tinygltf::TextureInfo plain = info;
+    plain.extensions.clear();
+    plain.texCoord = 0;
+    const int base = texture(plain, at);
+    if (base < 0) return -1;
+    const std::vector<float> key = {float(row0.x), float(row0.y), float(row0.z), float(row1.x), float(row1.y), float(row1.z)};
+    const auto found = transformMap_.find({info.index, key});
+    if (found != transformMap_.end()) return found->second;
+    Texture shared = scene_.textures[std::size_t(base)];
+    shared.rgba.clear();
+    shared.pixelSource = base;
+    shared.uvRow0 = glm::vec3(row0);
+    shared.uvRow1 = glm::vec3(row1);
+    scene_.textures.push_back(std::move(shared));
+    const int result = int(scene_.textures.size() - 1);
+    transformMap_[{info.index, key}] = result;
+    return result;
+  }
   const auto cached = textureMap_.find(info.index);
   if (cached != textureMap_.end()) return cached->second;
 

@@ -94,12 +94,14 @@ struct Emitter {
   float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
 };
 
-// A texture inside the texel SSBO (16 bytes).
+// A texture inside the texel SSBO (48 bytes). Several may share texels (KHR_texture_transform).
 struct TexInfo {
   uint offset;   // first texel in the texel SSBO
   uint width;    // texels
   uint height;   // texels
   uint flags;    // bit 0: repeat S (else clamp), bit 1: repeat T, bit 2: mirrored S, bit 3: mirrored T, bit 4: nearest filter
+  vec4 uvRow0;   // xyz: u' = dot(xyz, (u, v, 1)) (KHR_texture_transform; identity (1, 0, 0)); w unused
+  vec4 uvRow1;   // xyz: v' = dot(xyz, (u, v, 1)) (identity (0, 1, 0)); w unused
 };
 
 // Statistics the shader writes atomically.
@@ -140,7 +142,7 @@ static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
-static_assert(sizeof(TexInfo) == 16, "TexInfo must be 16 bytes (std430)");
+static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
 static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");

@@ -625,11 +625,11 @@ TEST_CASE("material contract: alpha modes, emission strength, glass extensions, 
   for (const auto& w : s.warnings) CHECK(w.rfind(s.path + ": ", 0) == 0);
 
   SUBCASE("a required unsupported extension is an error") {
-    g.doc["extensionsUsed"] = {"KHR_texture_transform"};
-    g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+    g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
     const std::string error = loadError(dir.write("transform.gltf", g.text()));
     CHECK(error.find("transform.gltf: ") != std::string::npos);
-    CHECK(error.find("KHR_texture_transform") != std::string::npos);
+    CHECK(error.find("KHR_draco_mesh_compression") != std::string::npos);
   }
 }
 
@@ -716,6 +716,46 @@ TEST_CASE("textures: external PNG and JPEG files, samplers, emissive texture") {
   CHECK(std::abs(int(emissive.rgba[2]) - 50) <= 3);
   CHECK(emissive.rgba[3] == 255);
   CHECK(emissive.repeatS);  // no sampler: REPEAT
+}
+
+TEST_CASE("textures: metallicRoughness, normal, MASK with texture alpha, KHR_texture_transform") {
+  TempDir dir;
+  const unsigned char png[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+  REQUIRE(stbi_write_png((dir.path / "tiny.png").string().c_str(), 2, 2, 4, png, 8));
+  Gltf g;
+  g.doc["images"] = {{{"uri", "tiny.png"}}};
+  g.doc["textures"] = {{{"source", 0}}};
+  const json transform = {{"KHR_texture_transform", {{"offset", {0.0, 1.0}}, {"rotation", 1.57079632679}, {"scale", {0.5, 0.5}}}}};
+  const int mat = g.add("materials", {{"pbrMetallicRoughness",
+                                       {{"baseColorTexture", {{"index", 0}}},
+                                        {"metallicRoughnessTexture", {{"index", 0}, {"extensions", transform}}}}},
+                                      {"normalTexture", {{"index", 0}, {"scale", 0.5}}},
+                                      {"alphaMode", "MASK"},
+                                      {"alphaCutoff", 0.4}});
+  g.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", mat}})}});
+  const Scene s = g.load(dir);
+  const caustica::Material& m = s.materials[0];
+  CHECK(m.baseColorTexture == m.normalTexture);  // the same glTF texture without a transform: one entry
+  CHECK(m.normalScale == 0.5f);
+  CHECK(m.alphaFromTexture);
+  CHECK(m.alphaCutoff == doctest::Approx(0.4));
+  CHECK(m.baseColor.a == 1.0f);  // the cutoff is applied per hit to factor x texture alpha
+  REQUIRE(m.metallicRoughnessTexture >= 0);
+  REQUIRE(s.textures.size() == 2);
+  const caustica::Texture& t = s.textures[std::size_t(m.metallicRoughnessTexture)];
+  CHECK(t.pixelSource == m.baseColorTexture);  // shares the texels
+  CHECK(t.rgba.empty());
+  // The extension's example: rotation pi/2, offset (0, 1), scale 0.5 maps (u, v) to the lower left
+  // quadrant: u' = 0.5 v, v' = 1 - 0.5 u.
+  const auto apply = [&](glm::vec2 uv) {
+    return glm::vec2(glm::dot(t.uvRow0, glm::vec3(uv, 1.0f)), glm::dot(t.uvRow1, glm::vec3(uv, 1.0f)));
+  };
+  CHECK(glm::length(apply({0, 0}) - glm::vec2(0.0f, 1.0f)) < 1e-6f);
+  CHECK(glm::length(apply({1, 0}) - glm::vec2(0.0f, 0.5f)) < 1e-6f);
+  CHECK(glm::length(apply({0, 1}) - glm::vec2(0.5f, 1.0f)) < 1e-6f);
+  for (const auto& w : s.warnings) CHECK(w.find("normalTexture") == std::string::npos);
 }
 
 TEST_CASE("external buffers: percent-encoded file names") {
