@@ -639,3 +639,57 @@ TEST_CASE("naive and mis agree per region: one GGX lobe filling the view") {
     checkRegionsAgree(s, names[kind], 4096, 2048, 900 + 10 * kind, 4.0);
   }
 }
+
+// A Lambertian square under a small, distant light straight above it, with a normal map: texel 0
+// flat, texel 1 tilted 60 degrees towards +u (nearest filtering). The square's uv stay inside texel 0,
+// so without a transform the image equals the unmapped one; KHR_texture_transform's offset of half the
+// texture moves every lookup to texel 1, and the radiance drops to cos(tilt): the 8-bit texel
+// (238, 128, 191) decodes to a normal at cos = 0.4982 from the light. Same seed in all three renders,
+// so the noise mostly cancels in the ratios; measured 0.99998 and 0.4985 (the light's extent moves the
+// latter from the single-direction cosine by 0.07 %).
+TEST_CASE("normal maps and KHR_texture_transform change the shading normal as the texel says") {
+  Scene s;
+  Material floor;
+  floor.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  Material light;
+  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  light.emission = glm::vec3(50.0f);
+  s.materials = {floor, light};
+  Texture map;
+  map.width = 2;
+  map.height = 1;
+  map.rgba = {128, 128, 255, 255, 238, 128, 191, 255};
+  map.nearest = true;
+  s.textures.push_back(map);
+  const glm::vec3 p[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  const glm::vec2 uv[4] = {{0.0f, 0.45f}, {0.45f, 0.45f}, {0.45f, 0.0f}, {0.0f, 0.0f}};  // u along +x, v down
+  for (auto idx : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+    Triangle t{};
+    for (int k = 0; k < 3; ++k) {
+      t.p[k] = p[idx[k]];
+      t.n[k] = glm::vec3(0, 0, 1);
+      t.uv[k] = uv[idx[k]];
+    }
+    s.triangles.push_back(t);
+  }
+  const float h = 0.3f;
+  addQuad(s, {-h, h, 8}, {h, h, 8}, {h, -h, 8}, {-h, -h, 8}, 1);  // facing -z, down onto the square
+  for (const auto& t : s.triangles)
+    for (const auto& q : t.p) s.bounds.grow(q);
+  Camera cam;
+  cam.position = {0.0f, -0.5f, 3.0f};
+  cam.forward = glm::normalize(glm::vec3(0.0f) - cam.position);
+  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
+  cam.yfov = 0.3f;
+  auto render = [&](const Scene& scene) { return meanOf(renderScene(scene, cam, small(24, 24, Integrator::Mis, 5), 32).image); };
+  const double plain = render(s);
+  Scene mapped = s;
+  mapped.materials[0].normalTexture = 0;
+  const double flat = render(mapped);
+  mapped.textures[0].uvRow0 = glm::vec3(1.0f, 0.0f, 0.5f);  // u' = u + 0.5: texel 1
+  const double tilted = render(mapped);
+  INFO("plain ", plain, ", mapped flat ", flat, ", mapped tilted ", tilted);
+  CHECK(plain > 0.01);
+  CHECK(flat / plain == Rel(1.0, 1e-4));
+  CHECK(tilted / plain == Rel(0.4982, 0.01));
+}
