@@ -443,7 +443,9 @@ class Gltf:
 
     def material(self, name, color=(0.8, 0.8, 0.8), alpha=1.0, metallic=0.0, roughness=1.0,
                  emissive=None, strength=1.0, transmission=0.0, ior=None, thickness=None,
-                 dispersion=None, double_sided=False, base_texture=None):
+                 dispersion=None, double_sided=False, base_texture=None, specular=0.0):
+        """specular: KHR_materials_specular's specularFactor of the dielectric layer over the diffuse
+        base. The shipped Cornell scenes are Lambertian (0, written out); glTF's default is 1."""
         pbr = {"baseColorFactor": [clean(c) for c in color] + [clean(alpha)],
                "metallicFactor": clean(metallic), "roughnessFactor": clean(roughness)}
         if base_texture is not None:
@@ -464,6 +466,8 @@ class Gltf:
             ext["KHR_materials_volume"] = {"thicknessFactor": clean(thickness)}
         if dispersion is not None:
             ext["KHR_materials_dispersion"] = {"dispersion": clean(dispersion)}
+        if specular != 1.0 and metallic < 1.0 and transmission < 1.0:
+            ext["KHR_materials_specular"] = {"specularFactor": clean(specular)}
         if ext:
             mat["extensions"] = ext
             self.extensions.update(ext.keys())
@@ -577,6 +581,27 @@ def cornell_glass(segments=64, rings=32):
     mirror_mesh = g.mesh("mirror sphere", [dict(prim, material=mirror)])
     g.node("glass sphere", mesh=glass_mesh, translation=(-0.42, radius, 0.3))
     g.node("mirror sphere", mesh=mirror_mesh, translation=(0.42, radius, -0.35))
+    g.camera("camera", **CORNELL_CAMERA)
+    return g.finish()
+
+
+def cornell_materials(segments=48, rings=24):
+    """glTF metallic-roughness under two area lights: a rough gold metal sphere, a red plastic sphere
+    (GGX specular layer over a diffuse base, glTF's default specular) and a frosted glass sphere."""
+    g = Gltf()
+    add_cornell_box(g)
+    add_ceiling_light(g, 0.4, 0.3, x=-0.35)
+    add_ceiling_light(g, 0.4, 0.3, x=0.35)
+    radius = 0.3
+    gold = g.material("rough gold", color=(1.0, 0.766, 0.336), metallic=1.0, roughness=0.35)
+    plastic = g.material("red plastic", color=(0.6, 0.05, 0.04), roughness=0.25, specular=1.0)
+    frosted = g.material("frosted glass", color=(1.0, 1.0, 1.0), roughness=0.3, transmission=1.0, ior=1.5,
+                         thickness=2 * radius)
+    prim = g.primitive(uv_sphere(radius, segments, rings), gold)
+    for name, material, position in (("gold sphere", gold, (-0.5, radius, -0.3)),
+                                     ("plastic sphere", plastic, (0.5, radius, -0.2)),
+                                     ("frosted sphere", frosted, (0.0, radius, 0.35))):
+        g.node(name, mesh=g.mesh(name, [dict(prim, material=material)]), translation=position)
     g.camera("camera", **CORNELL_CAMERA)
     return g.finish()
 
@@ -1014,6 +1039,7 @@ def main():
         os.path.join(SCENES, "cornell-dispersion.gltf"): cornell_dispersion(),
         os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
         os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
+        os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),

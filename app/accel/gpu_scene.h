@@ -16,10 +16,14 @@ struct SceneFeatures {
   bool mirror = false, glass = false, volume = false, dispersion = false, textures = false, opacity = false;
   bool punctual = false;      // KHR_lights_punctual lights: CAUSTICA_PUNCTUAL (their NEE, in both integrators)
   bool spotEmitters = false;  // --light-radius spheres of spot lights: CAUSTICA_SPOT_EMITTERS
+  bool ggx = false;  // a rough metal or glass, or a specular layer over a diffuse base (CAUSTICA_GGX)
   std::vector<std::string> defines() const;  // material defines only (not integrator or dispersion mode)
   std::string describe() const;              // e.g. "mirror glass dispersion" or "diffuse only"
 };
 SceneFeatures sceneFeatures(const Scene& scene);
+// True when the material has a GGX lobe: a metal or glass part with roughness^2 >= kDeltaAlpha (or a
+// metallicRoughness texture), or a diffuse part with a specular layer (specularF90 > 0).
+bool hasRoughLobe(const Material& m);
 
 struct GpuScene {
   std::vector<gpu::BvhNode> nodes;

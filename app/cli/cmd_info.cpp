@@ -9,16 +9,19 @@
 #include "accel/bvh.h"
 #include "util/error.h"
 #include "accel/gpu_scene.h"
+#include "shading/microfacet.h"
 
 namespace caustica::cli {
 
 namespace {
 std::string materialKind(const Material& m) {
   std::string kind;
-  if (m.metallic >= 1.0f) kind = "mirror";
+  const bool rough = m.roughness * m.roughness >= kDeltaAlpha;  // GGX lobes (docs/materials.md)
+  if (m.metallic >= 1.0f) kind = rough ? "rough metal" : "mirror";
   else if (m.transmission > 0.0f) kind = m.transmission >= 1.0f && m.metallic <= 0.0f ? "glass" : "glass/diffuse mix";
   else if (m.metallic > 0.0f) kind = "mirror/diffuse mix";
-  else kind = "diffuse";
+  else kind = m.specularF90 > 0.0f ? "plastic (specular layer over diffuse)" : "diffuse";
+  if (rough && m.transmission > 0.0f && m.metallic < 1.0f) kind += " (rough glass)";
   if (m.dispersion > 0.0f) kind += " +dispersion";
   if (m.baseColor.a < 1.0f) kind += " +opacity";
   if (m.isEmissive()) kind = "emitter, " + kind;

@@ -55,6 +55,8 @@ CAUSTICA_CONST uint kMatSpotEmitter = 256u;
 CAUSTICA_CONST uint kPunctualPoint = 0u;
 CAUSTICA_CONST uint kPunctualSpot = 1u;
 CAUSTICA_CONST uint kPunctualDirectional = 2u;
+CAUSTICA_CONST uint kMatAlphaTexture = 8u;   // alphaMode BLEND or MASK: the base-colour texture's alpha multiplies baseColor.a
+CAUSTICA_CONST uint kMatAlphaMask = 16u;     // alphaMode MASK with a texture: opaque where alpha >= cutoff (tex2.w), else absent
 
 // FrameParams.options.w flags
 CAUSTICA_CONST uint kFlagMis = 1u;           // next-event estimation + MIS (else pure BSDF sampling)
@@ -84,13 +86,16 @@ struct TriShade {
   vec4 vt;  // x,y,z: v of texcoords 0,1,2; w unused
 };
 
-// Material after the glTF material contract (docs/materials.md), 80 bytes.
+// Material after the glTF material contract (docs/materials.md), 112 bytes.
 struct Material {
   vec4 baseColor;     // rgb: linear base colour factor; a: opacity (1 = opaque)
   vec4 emission;      // rgb: emitted radiance (linear, W sr^-1 m^-2 relative units); w: unused
-  vec4 params;        // x: metallic (mirror weight), y: roughness, z: transmission, w: ior at 587.6 nm
+  vec4 params;        // x: metallic (metal weight), y: roughness (GGX alpha = y^2), z: transmission, w: ior at 587.6 nm
   vec4 absorption;    // rgb: absorption coefficient sigma_a per scene unit (Beer–Lambert); w: abbe number V (0 = none)
   uvec4 tex;          // x: base-colour texture index, y: emissive texture index (kInvalidIndex = none), z: flags, w unused
+  vec4 specular;      // rgb: F0 of the dielectric specular layer over the diffuse base; w: its F90 (0 = Lambertian base)
+  uvec4 tex2;         // x: metallicRoughness texture, y: normal texture (kInvalidIndex = none); z: normal scale,
+                      // w: alpha cutoff (both float bits)
 };
 
 // One alias-table slot over emissive triangles (16 bytes).
@@ -101,12 +106,14 @@ struct Emitter {
   float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
 };
 
-// A texture inside the texel SSBO (16 bytes).
+// A texture inside the texel SSBO (48 bytes). Several may share texels (KHR_texture_transform).
 struct TexInfo {
   uint offset;   // first texel in the texel SSBO
   uint width;    // texels
   uint height;   // texels
   uint flags;    // bit 0: repeat S (else clamp), bit 1: repeat T, bit 2: mirrored S, bit 3: mirrored T, bit 4: nearest filter
+  vec4 uvRow0;   // xyz: u' = dot(xyz, (u, v, 1)) (KHR_texture_transform; identity (1, 0, 0)); w unused
+  vec4 uvRow1;   // xyz: v' = dot(xyz, (u, v, 1)) (identity (0, 1, 0)); w unused
 };
 
 // Statistics the shader writes atomically.
@@ -181,9 +188,9 @@ static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "Punctu
 static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");
-static_assert(sizeof(Material) == 80, "Material must be 80 bytes (std430)");
+static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
-static_assert(sizeof(TexInfo) == 16, "TexInfo must be 16 bytes (std430)");
+static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
 static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
