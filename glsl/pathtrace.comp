@@ -12,6 +12,9 @@
 #include "lib/spectral.glsl"
 #include "lib/materials.glsl"
 #include "lib/lights.glsl"
+#ifdef CAUSTICA_ENV
+#include "lib/environment.glsl"
+#endif
 #ifdef CAUSTICA_CASTERS
 #include "lib/casters.glsl"
 #endif
@@ -24,6 +27,9 @@ shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samp
 uint gSecondaryRays = 0u;
 const uint kMaxPassThroughs = 256u;  // alpha pass-throughs a path may make beyond its bounces
 uint gShadowRays = 0u;
+#ifdef CAUSTICA_ENV
+#include "lib/environment_light.glsl"
+#endif
 
 // One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
 vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
@@ -44,7 +50,12 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   for (uint depth = 0u; depth < maxDepth; ++depth) {
     if (depth + passThroughs > 0u) ++gSecondaryRays;
     Hit hit;
-    if (!traceClosest(org, dir, 3.0e38, hit)) break;
+    if (!traceClosest(org, dir, 3.0e38, hit)) {
+#ifdef CAUSTICA_ENV
+      radiance += beta * filt * escapedRadiance(dir, depth == 0u, prevDelta, prevPdf);  // environment_light.glsl
+#endif
+      break;
+    }
 #ifdef CAUSTICA_VOLUME
     beta *= exp(-sigma * hit.t);
 #endif
@@ -148,6 +159,13 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
           }
         }
       }
+#ifdef CAUSTICA_ENV
+      // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
+      // Not inside an absorbing medium: the ray could only leave through its boundary.
+      vec2 uEnv = rand2(rng);
+      if (depth + 1u < maxDepth && sigma == vec3(0.0))
+        radiance += beta * filt * addEnvironmentLight(p, pError, ng, ns, base.rgb, uEnv);
+#endif
 #endif
 #ifdef CAUSTICA_CASTERS
       float cosOut = dot(newDir, ns);

@@ -8,12 +8,14 @@
 #include "accel/bvh.h"
 #include "scene/caustic_casters.h"
 #include "scene/scene.h"
+#include "shading/environment_sampling.h"
 
 namespace caustica {
 
 // What the scene's materials need; each maps to one CAUSTICA_* shader define.
 struct SceneFeatures {
   bool mirror = false, glass = false, volume = false, dispersion = false, textures = false, opacity = false;
+  bool environment = false;  // an environment that emits, or a background other than it (CAUSTICA_ENV)
   std::vector<std::string> defines() const;  // material defines only (not integrator or dispersion mode)
   std::string describe() const;              // e.g. "mirror glass dispersion" or "diffuse only"
 };
@@ -32,6 +34,9 @@ struct GpuScene {
   std::vector<CausticCaster> casters;   // caustic casters (findCausticCasters), at most CAUSTICA_MAX_CASTERS
   glm::vec4 emitterSphere{0.0f, 0.0f, 0.0f, -1.0f};  // around every emitter (emitterBoundingSphere)
   SceneFeatures features;
+  // The environment map and its sampling CDFs (width 0: no environment light).
+  EnvironmentDistribution environment;
+  gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
 };
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh);

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "cli/environment_options.h"
 #include "scene/assets.h"
 #include "util/error.h"
 
@@ -124,6 +125,7 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
       {"--quiet", "-q", "", "print nothing but errors"},
   };
+  for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   return specs;
 }
@@ -274,6 +276,7 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
   LoadedScene ls;
   ls.scene = loadScene(path, loadOptions);
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
+  applyEnvironmentOptions(opts, ls.scene, verbose);  // environment_options.cpp
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {
     if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");

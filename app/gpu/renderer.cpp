@@ -46,13 +46,14 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
   uploadCasters();
+  environment_.upload(g, limits_, scene.path);
   allocateImages();
   program();  // compile now, so shader errors surface before rendering starts
 }
 
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
-  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) {
+  if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
   }
@@ -156,6 +157,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
   frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
+  environment_.bind();
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested

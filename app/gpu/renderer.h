@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
 #include "accel/gpu_scene.h"
@@ -85,6 +86,7 @@ class Renderer {
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
+  EnvironmentTextures environment_;  // environment map, CDFs and UBO
   GlTexture accum_, comp_, display_;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;

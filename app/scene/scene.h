@@ -8,6 +8,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/environment.h"
+
 namespace caustica {
 
 // A base-colour or emissive texture, decoded to 8-bit RGBA (values as stored: sRGB-encoded colour).
@@ -87,7 +89,18 @@ struct Scene {
   // the world origin than its own size, the loader subtracts its centre from every position and
   // camera before converting to float, so it keeps full float precision; 0 for other scenes.
   glm::dvec3 origin{0.0};
+  // Light from infinity and what escaping camera rays see (scene/environment.h, docs/lighting.md).
+  // Set from the command line (--env, --background), not from the file.
+  Environment environment;
+  Background background;
 };
+
+// Whether anything in the scene emits light: an emissive triangle or an environment that emits.
+inline bool sceneHasLights(const Scene& s) {
+  for (const Triangle& t : s.triangles)
+    if (t.material < s.materials.size() && s.materials[t.material].isEmissive()) return true;
+  return s.environment.emits();
+}
 
 // What loadScene accepts from a scene file it does not trust (docs/untrusted-input.md). Each limit
 // is checked before the memory it guards is spent; the defaults suit scenes up to a few GiB of GPU memory.
