@@ -73,7 +73,8 @@ glm::vec2 envDirectionToUv(const glm::vec3& d, float cosRot, float sinRot) {
   float x = cosRot * d.x - sinRot * d.z;
   float z = sinRot * d.x + cosRot * d.z;
   float u = 0.5f + std::atan2(z, x) * kInvTwoPi;
-  float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi;
+  // v = acos(d.y) / pi, as atan2: accurate everywhere (llvmpipe's acos is off by up to 1e-4 rad).
+  float v = std::atan2(std::sqrt(x * x + z * z), d.y) * kInvPi;
   return {u, v};
 }
 

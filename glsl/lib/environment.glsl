@@ -21,7 +21,8 @@ vec2 envDirectionToUv(vec3 d, float cosRot, float sinRot) {
   float x = cosRot * d.x - sinRot * d.z;
   float z = sinRot * d.x + cosRot * d.z;
   float u = 0.5 + atan(z, x) * kEnvInvTwoPi;
-  float v = acos(clamp(d.y, -1.0, 1.0)) * INV_PI;
+  // v = acos(d.y) / pi, as atan2: accurate everywhere (llvmpipe's acos is off by up to 1e-4 rad).
+  float v = atan(sqrt(x * x + z * z), d.y) * INV_PI;
   return vec2(u, v);
 }
 

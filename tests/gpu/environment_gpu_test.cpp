@@ -4,7 +4,9 @@
 // seen through the camera, and naive vs mis agreement under a small bright sun.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -138,9 +140,10 @@ TEST_CASE("environment twins: GLSL sampleEnvironment, environmentPdf, environmen
   std::vector<glm::uvec4> out(static_cast<size_t>(n) * 4);
   outBuf.read(0, out.size() * sizeof(glm::uvec4), out.data());
 
-  // Measured on llvmpipe: direction components differ by at most ~3e-7 (sin/cos/atan/acos rounding);
-  // pdfs by ~1e-6 relative where both pick the same texel. Lookups at a texel edge may round to the
-  // neighbouring texel in one of the two: rare (none of 20000 random directions measured).
+  // Measured on llvmpipe (20000 records): directions differ by at most 1.9e-7, uv by 1.1e-6 (v is
+  // computed with atan2: llvmpipe's acos was off by 3e-5 in v, which moved 8 lookups into the
+  // neighbouring texel), pdfs by 6.8e-7 relative, no texel chosen differently. Tolerances ~10x those;
+  // a lookup at a texel edge may still round to the neighbour in one of the two (2 allowed).
   double maxDir = 0, maxPdf = 0, maxUv = 0, maxBack = 0;
   int sampleMismatch = 0, lookupMismatch = 0;
   const EnvironmentDistribution& d = g.environment;
@@ -170,10 +173,10 @@ TEST_CASE("environment twins: GLSL sampleEnvironment, environmentPdf, environmen
           ", sample mismatches ", sampleMismatch, ", lookup mismatches ", lookupMismatch);
   CHECK(sampleMismatch == 0);
   CHECK(lookupMismatch <= 2);
-  CHECK(maxDir < 2e-5);
-  CHECK(maxPdf < 1e-4);
-  CHECK(maxUv < 2e-6);
-  CHECK(maxBack < 2e-5);
+  CHECK(maxDir < 2e-6);
+  CHECK(maxPdf < 1e-5);
+  CHECK(maxUv < 1e-5);
+  CHECK(maxBack < 2e-6);
 }
 
 TEST_CASE("environment furnace: a diffuse box of albedo 0.5 under a uniform sky of radiance 1 is 0.5, the sky 1") {
@@ -203,38 +206,58 @@ TEST_CASE("environment furnace: a diffuse box of albedo 0.5 under a uniform sky 
       objects += obj;
       skies += sky;
     }
+  // Only pixels whose 3 x 3 neighbourhood is all object or all sky: the other renders' samples fall
+  // elsewhere in a pixel, so a pixel beside the silhouette may see both.
+  std::vector<int> inner(cls.size(), -1);
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      int k = cls[static_cast<size_t>(y) * w + x];
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (cls[static_cast<size_t>(y + dy) * w + x + dx] != k) k = -1;
+      inner[static_cast<size_t>(y) * w + x] = k;
+    }
   INFO("object pixels ", objects, ", sky pixels ", skies);
   CHECK(objects > w * h / 5);
   CHECK(skies > w * h / 5);
   CHECK(objects + skies + 4 * (w + h) > w * h);  // everything else is on the silhouette
-  // mis: environment sampling and BSDF sampling, MIS-weighted; the same answer with noise. Measured
-  // standard deviation of one object pixel at 16 spp: ~0.04; of the mean over ~900 object pixels:
-  // ~0.0013 (0.27 % of 0.5), so 0.5 % (1.9 sigma... ) is too tight for one render: 4 renders of 16 spp
-  // give ~0.0007, and the tolerance 0.0025 (0.5 % of 0.5, 3.6 sigma) fails a 0.5 % bias.
-  double sumObj = 0;
-  int nObj = 0;
-  for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+  // mis: environment sampling and BSDF sampling, MIS-weighted; the same answer with noise. The
+  // standard error of the object mean comes from the spread of 8 renders of 16 spp (measured: about
+  // 0.05 % of 0.5); the tolerance 0.5 % must be at least 4.5 standard errors (asserted), so a 0.5 %
+  // bias fails and noise alone does not.
+  const int renders = 8;
+  std::vector<double> means;
+  for (std::uint32_t seed = 1; seed <= renders; ++seed) {
     RenderResult mis = renderScene(s, cam, settingsFor(w, h, Integrator::Mis, seed), 16);
     CHECK(mis.stats.nonFinite == 0);
     bool hasEnv = false;
     for (const auto& def : mis.defines) hasEnv |= def == "CAUSTICA_ENV";
     CHECK(hasEnv);
+    double sumObj = 0;
+    int nObj = 0, skyOff = 0;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
-        int k = cls[static_cast<size_t>(y) * w + x];
+        int k = inner[static_cast<size_t>(y) * w + x];
         for (int c = 0; c < 3; ++c) {
           float v = mis.image.at(x, y, c);
-          if (k == 1) CHECK(v == 1.0f);
+          if (k == 1) skyOff += v != 1.0f;
           if (k == 0) {
             sumObj += v;
             ++nObj;
           }
         }
       }
+    CHECK(skyOff == 0);
+    means.push_back(sumObj / nObj);
   }
-  double meanObj = sumObj / nObj;
-  MESSAGE("environment furnace, mis: mean over object pixels ", meanObj, " (exact 0.5)");
-  CHECK(meanObj == Rel(0.5, 0.005));
+  double mean = 0, var = 0;
+  for (double m : means) mean += m / renders;
+  for (double m : means) var += (m - mean) * (m - mean) / (renders - 1);
+  double se = std::sqrt(var / renders);
+  MESSAGE("environment furnace, mis: mean over object pixels ", mean, " (exact 0.5), standard error ", se, " (",
+          100.0 * se / 0.5, " %)");
+  CHECK(4.5 * se <= 0.005 * 0.5);
+  CHECK(mean == Rel(0.5, 0.005));
 }
 
 TEST_CASE("environment convention: a camera looking down -Z sees u = 0.25 in the middle, u grows to the right; rotation") {
@@ -316,7 +339,11 @@ TEST_CASE("environment: naive and mis agree under a small bright sun (floor, box
   cam.forward = glm::normalize(glm::vec3(0.0f, 0.3f, 0.0f) - cam.position);
   cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
   cam.yfov = 0.8f;
-  const int w = 32, h = 32, renders = 6;
+  // Measured (llvmpipe, 8 renders): standard error of the image mean ~0.45 % for naive at 512 spp,
+  // ~0.2 % for mis at 64 spp, so this run detects a ~2.2 % bias of the image mean (printed);
+  // CAUSTICA_LONG_TESTS=1 takes 16x the samples and must detect 0.5 % (asserted).
+  const bool longRun = std::getenv("CAUSTICA_LONG_TESTS") != nullptr;
+  const int w = 32, h = 32, renders = 8, factor = longRun ? 16 : 1;
   auto regions = [&](Integrator integ, int spp, std::uint32_t seedBase) {
     std::vector<std::array<double, 5>> out;
     for (int r = 0; r < renders; ++r) {
@@ -335,8 +362,8 @@ TEST_CASE("environment: naive and mis agree under a small bright sun (floor, box
     }
     return out;
   };
-  auto a = regions(Integrator::Naive, 128, 100);
-  auto b = regions(Integrator::Mis, 32, 200);
+  auto a = regions(Integrator::Naive, 512 * factor, 100);
+  auto b = regions(Integrator::Mis, 64 * factor, 200);
   static const char* kRegion[] = {"image", "top left", "top right", "bottom left", "bottom right"};
   for (int k = 0; k < 5; ++k) {
     auto stats = [&](const std::vector<std::array<double, 5>>& v) {
@@ -348,9 +375,10 @@ TEST_CASE("environment: naive and mis agree under a small bright sun (floor, box
     auto [ma, va] = stats(a);
     auto [mb, vb] = stats(b);
     double se = std::sqrt(va + vb);
-    INFO(kRegion[k], ": naive ", ma, " mis ", mb, ", standard error of the difference ", se, " (",
+    INFO(std::string(kRegion[k]), ": naive ", ma, " mis ", mb, ", standard error of the difference ", se, " (",
          100.0 * se / (0.5 * (ma + mb)), " %)");
     CHECK(std::abs(ma - mb) <= 4.5 * se);
+    if (k == 0 && longRun) CHECK(4.5 * se <= 0.005 * 0.5 * (ma + mb));
     if (k == 0)
       MESSAGE("environment sun: naive ", ma, ", mis ", mb, "; smallest image-mean bias this run detects ",
               100.0 * 4.5 * se / (0.5 * (ma + mb)), " %; mis standard error ", 100.0 * std::sqrt(vb) / mb,
