@@ -103,7 +103,7 @@ TEST_CASE("every feature combination of pathtrace.comp compiles (glslang, GLSL 4
 
 TEST_CASE("the other entry shaders compile") {
   ShaderLibrary lib;
-  for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/twins_test.comp"}) {
+  for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/twins_test.comp", "tests/environment_test.comp"}) {
     std::string log = validate(lib.expand(entry, {}));
     INFO(entry);
     CHECK_MESSAGE(log.empty(), log);
