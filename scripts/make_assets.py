@@ -717,8 +717,9 @@ def quat_look(direction):
 
 def sun_glass():
     """A glass ball and a clay box on a grey floor, open to the sky: no emitters; meant for an
-    environment (render with --env assets/env/sun-sky.hdr, written by scripts/make_sky_hdr.py: its
-    sun stands 35 degrees high in front of the camera, so the ball's caustic falls towards it)."""
+    environment (render with --env sun-sky: assets/env/sun-sky.hdr, written by scripts/make_sky_hdr.py;
+    its sun stands 35 degrees high, in front of the camera and to the left, so the ball's shadow and
+    caustic fall to its right, towards the camera)."""
     g = Gltf()
     floor = g.material("floor", color=(0.7, 0.7, 0.7))
     clay = g.material("clay", color=(0.75, 0.35, 0.2))
@@ -728,9 +729,9 @@ def sun_glass():
     mesh.polygon([(-6, 0, -6), (6, 0, -6), (6, 0, 6), (-6, 0, 6)], (0, 1, 0))
     g.object("floor", mesh, floor)
     g.object("glass ball", uv_sphere(0.5, 64, 32), glass, translation=(0.0, 0.5, 0.0))
-    g.object("clay box", unit_cube(), clay, translation=(-1.15, 0.3, -0.4), rotation=quat_y(25.0),
+    g.object("clay box", unit_cube(), clay, translation=(1.2, 0.3, -1.0), rotation=quat_y(25.0),
              scale_=(0.6, 0.6, 0.6))
-    eye, target = (0.2, 1.7, 3.8), (0.05, 0.25, 0.25)
+    eye, target = (0.3, 1.8, 3.9), (0.45, 0.2, 0.2)
     g.camera("camera", position=eye, yfov=0.6, rotation=quat_look(sub(target, eye)))
     return g.finish()
 

@@ -12,7 +12,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "assets", "env", "sun-sky.hdr")
 WIDTH, HEIGHT = 256, 128
 
-SUN_DIR = (-0.4, 0.0, -0.8)      # azimuth (x, z) of the sun: in front of and left of a camera looking down -z
+SUN_DIR = (-0.8, 0.0, -0.4)      # azimuth (x, z) of the sun: left of and in front of a camera looking down -z
 SUN_ELEVATION = 35.0             # degrees above the horizon
 SUN_RADIUS = 2.0                 # degrees (the real sun: 0.27); larger so the map resolves it as a disc
 SUN_RADIANCE = (3000.0, 2700.0, 2250.0)  # warm; its irradiance is a few times the sky's

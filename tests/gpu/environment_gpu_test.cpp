@@ -258,6 +258,19 @@ TEST_CASE("environment furnace: a diffuse box of albedo 0.5 under a uniform sky 
           100.0 * se / 0.5, " %)");
   CHECK(4.5 * se <= 0.005 * 0.5);
   CHECK(mean == Rel(0.5, 0.005));
+
+  // --background 0.25: camera rays that leave see the colour; the object is still lit by the sky.
+  s.background.kind = Background::Kind::Color;
+  s.background.color = glm::vec3(0.25f);
+  RenderResult bg = renderScene(s, cam, settingsFor(w, h, Integrator::Naive), 4);
+  int off = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      int k = inner[static_cast<size_t>(y) * w + x];
+      for (int c = 0; c < 3; ++c)
+        if (k >= 0) off += bg.image.at(x, y, c) != (k == 1 ? 0.25f : 0.5f);
+    }
+  CHECK(off == 0);
 }
 
 TEST_CASE("environment convention: a camera looking down -Z sees u = 0.25 in the middle, u grows to the right; rotation") {
