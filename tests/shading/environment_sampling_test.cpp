@@ -9,6 +9,7 @@
 
 #include <stb_image_write.h>
 
+#include "image/image_io.h"
 #include "shading/environment_sampling.h"
 #include "shading/sampling.h"
 #include "util/error.h"
@@ -169,7 +170,7 @@ TEST_CASE("environment sampling: the sun gets its share of samples; a uniform sk
   }
 }
 
-TEST_CASE("environment files: .hdr read with strength; bad input named; --env and --background text") {
+TEST_CASE("environment files: .hdr and .exr read with strength; bad input named; --env and --background text") {
   namespace fs = std::filesystem;
   fs::path p = fs::temp_directory_path() / "caustica_env_test.hdr";
   std::vector<float> px = {1.0f, 2.0f, 4.0f, 0.5f, 0.25f, 0.125f, 8.0f, 16.0f, 32.0f, 0.0f, 0.0f, 0.0f};
@@ -181,6 +182,15 @@ TEST_CASE("environment files: .hdr read with strength; bad input named; --env an
   CHECK(e.emits());
   CHECK(e.rotationDegrees == 15.0f);
   CHECK(e.describe().find("2x2, strength 2, rotation 15 deg") != std::string::npos);
+
+  // .exr through tinyexr (linear float, no quantisation).
+  fs::path exr = fs::temp_directory_path() / "caustica_env_test.exr";
+  Image img{2, 2, px};
+  writeImage(exr.string(), img);
+  Environment x = loadEnvironmentMap(exr.string(), 0.5f);
+  REQUIRE(x.width == 2);
+  for (size_t i = 0; i < px.size(); ++i) CHECK(x.rgb[i] == 0.5f * px[i]);
+  fs::remove(exr);
 
   fs::path bad = fs::temp_directory_path() / "caustica_env_bad.hdr";
   { std::FILE* f = std::fopen(bad.string().c_str(), "wb"); std::fputs("not an image", f); std::fclose(f); }
