@@ -114,6 +114,9 @@ double Options::getDouble(const std::string& name, double fallback) const {
 std::vector<OptionSpec> sceneOptionSpecs() {
   std::vector<OptionSpec> specs = {
       {"--size", "", "W[xH]", "image size in pixels (default 512; H follows the camera's aspect)"},
+      {"--mode", "", "MODE",
+       "path (the path tracer; default), whitted (ray tracer: point lights, mirrors, glass, no GI) or raster "
+       "(OpenGL raster pipeline) (docs/render-modes.md)"},
       {"--seed", "", "S", "random seed (default 1); the same seed gives the same image"},
       {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
       {"--dispersion", "", "MODE", "rgb (one channel per path; default) or spectral (hero wavelength)"},
@@ -304,6 +307,7 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
   if (!opts.isList("--integrator")) s.integrator = parseIntegrator(opts.get("--integrator", integratorName(defaults.integrator)));
   if (!opts.isList("--dispersion"))
     s.dispersion = parseDispersionMode(opts.get("--dispersion", dispersionModeName(defaults.dispersion)));
+  if (!opts.isList("--mode")) s.mode = parseRenderMode(opts.get("--mode", renderModeName(defaults.mode)));
   s.casterProbability = static_cast<float>(opts.getDouble("--caster-probability", defaults.casterProbability));
   if (!(s.casterProbability >= 0.0f && s.casterProbability <= kMaxCasterProbability)) {
     std::ostringstream m;

@@ -71,7 +71,7 @@ int cmdRender(const std::vector<std::string>& args) {
                   std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
                   renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
-                  integratorName(settings.integrator));
+                  (settings.mode == RenderMode::Path ? integratorName(settings.integrator) : renderModeName(settings.mode)));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);
     note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");

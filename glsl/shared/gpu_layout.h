@@ -29,10 +29,12 @@ using uint = std::uint32_t;
 #define CAUSTICA_SSBO_COUNT 8         // SSBO bindings used by the path tracer
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
 #define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
-#define CAUSTICA_BINDING_ENVIRONMENT 2  // UBO: EnvironmentParams (environment map size, rotation, background)
+#define CAUSTICA_BINDING_ENVIRONMENT 3  // UBO: EnvironmentParams (environment map size, rotation, background)
 #define CAUSTICA_TEXUNIT_ENV_MAP 0      // texture unit: rgba32f environment map (rgb radiance, a conditional CDF)
 #define CAUSTICA_TEXUNIT_ENV_MARGINAL 1 // texture unit: rgba32f height x 1 (r: marginal CDF over rows)
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
+#define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
+#define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
 #define CAUSTICA_IMAGE_ACCUM 0        // image unit: rgba32f running sum of radiance
 #define CAUSTICA_IMAGE_COMP 1         // image unit: rgba32f Kahan compensation of the sum
 #define CAUSTICA_IMAGE_DISPLAY 2      // image unit: rgba8 tone-mapped display image
@@ -145,8 +147,24 @@ struct EnvironmentParams {
   vec4 background;   // rgb: linear radiance camera rays see for kBackgroundColor; a unused
 };
 
+// The raster and Whitted modes light the scene with point lights: the emissive triangles grouped
+// into at most CAUSTICA_MAX_POINT_LIGHTS lights at their power-weighted centres (app/scene/light_groups.h).
+// Radiant intensity towards unit direction w (from the light): intensity.rgb * (max(0, dot(axis.xyz, w)) + position.w),
+// so a flat one-sided emitter keeps its cosine lobe and a closed one shines evenly (std140).
+struct PointLight {
+  vec4 position;   // xyz: world-space position; w: isotropic part of the lobe (0 flat .. 1/4 closed)
+  vec4 intensity;  // rgb: sum of emitted radiance * area (* 2 if double-sided); w: shadow far distance (scene units)
+  vec4 axis;       // xyz: mean emitter normal, length = the flat part of the lobe (0..1); w: unused
+};
+struct PointLights {
+  uvec4 count;                                  // x: lights in use (0..CAUSTICA_MAX_POINT_LIGHTS); yzw unused
+  PointLight light[CAUSTICA_MAX_POINT_LIGHTS];
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(EnvironmentParams) == 48, "EnvironmentParams must be 48 bytes (std140)");
+static_assert(sizeof(PointLight) == 48, "PointLight must be 48 bytes (std140)");
+static_assert(sizeof(PointLights) == 16 + 48 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
 static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");
