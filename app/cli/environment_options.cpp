@@ -18,6 +18,17 @@ std::vector<OptionSpec> environmentOptionSpecs() {
   };
 }
 
+namespace {
+// The raster and Whitted modes light with the emitters only (docs/render-modes.md): say so when
+// the environment is all the light there is.
+void noteModeWithoutEnvironment(const Options& opts, const Scene& scene, bool verbose) {
+  const std::string mode = opts.get("--mode", "path");
+  if (mode != "path" && scene.environment.emits())
+    note(!verbose, "warning: the image will be black: --mode " + mode + " does not see the environment yet and " +
+                       scene.path + " has no emissive triangles (use --mode path)");
+}
+}  // namespace
+
 void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
   const float strength = static_cast<float>(opts.getDouble("--env-strength", 1.0));
   const float rotation = static_cast<float>(opts.getDouble("--env-rotation", 0.0));
@@ -31,6 +42,8 @@ void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
       note(!verbose, "warning: the image will be black: " + scene.path +
                          " has no emissive triangles and the environment emits nothing (--env " +
                          opts.get("--env", "") + ")");
+    else if (!emitters)
+      noteModeWithoutEnvironment(opts, scene, verbose);
     return;
   }
   if (emitters) return;
@@ -39,6 +52,7 @@ void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
   scene.environment.isDefault = true;
   note(!verbose, scene.path + " has no emissive triangles: lit by the default environment, a uniform sky of radiance 1 "
                               "(--env FILE|RGB to choose one, --env none for none)");
+  noteModeWithoutEnvironment(opts, scene, verbose);
 }
 
 std::string lightingSummary(const Scene& scene, std::size_t emitterTriangles) {
