@@ -18,6 +18,8 @@ std::vector<std::string> SceneFeatures::defines() const {
   if (textures) d.push_back("CAUSTICA_TEXTURES");
   if (opacity) d.push_back("CAUSTICA_OPACITY");
   if (environment) d.push_back("CAUSTICA_ENV");
+  if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
+  if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
   return d;
 }
 
@@ -33,6 +35,8 @@ std::string SceneFeatures::describe() const {
   add(textures, "textures");
   add(opacity, "opacity");
   add(environment, "environment");
+  add(punctual, "punctual");
+  add(spotEmitters, "spot-emitters");
   return s.empty() ? "diffuse only" : s;
 }
 
@@ -54,6 +58,8 @@ SceneFeatures sceneFeatures(const Scene& scene) {
     f.opacity |= m.baseColor.a < 1.0f;
   }
   f.environment = scene.environment.emits() || scene.background.kind != Background::Kind::Environment;
+  f.punctual = !scene.punctualLights.empty();
+  for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
   return f;
 }
 
@@ -148,6 +154,15 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
                         flags, 0u);
     g.materials.push_back(gm);
   }
+  for (const SpotEmitter& e : scene.spotEmitters) {  // --light-radius spheres of spot lights
+    if (e.material >= g.materials.size()) continue;
+    gpu::Material& gm = g.materials[e.material];
+    gm.absorption = glm::vec4(e.axis, e.cosOuter);
+    gm.emission.w = e.cosInner;
+    gm.tex.z |= gpu::kMatSpotEmitter;
+  }
+  g.punctual = packPunctualLights(scene.punctualLights, scene.bounds, scene.path);
+  g.features.punctual = g.punctual.count.x > 0;
 
   for (const Texture& t : scene.textures) {
     gpu::TexInfo info{};

@@ -124,6 +124,9 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--caster-probability", "", "P",
        "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
+      {"--light-radius", "", "R",
+       "turn point and spot lights into emissive spheres of radius R (scene units), same power: bounces find "
+       "them, so their caustics appear (more noise)"},
       {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
       {"--quiet", "-q", "", "print nothing but errors"},
@@ -279,6 +282,14 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
   LoadedScene ls;
   ls.scene = loadScene(path, loadOptions);
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
+  if (opts.has("--light-radius")) {
+    const double r = opts.getDouble("--light-radius", 0.0);
+    if (!(r > 0.0) || r > 3.0e38) throw Error("option --light-radius needs a positive number of scene units");
+    const std::size_t before = ls.scene.punctualLights.size();
+    applyLightRadius(ls.scene, static_cast<float>(r));
+    note(!verbose, "--light-radius: " + std::to_string(before - ls.scene.punctualLights.size()) +
+                       " point/spot light(s) made emissive spheres of radius " + opts.get("--light-radius", ""));
+  }
   applyEnvironmentOptions(opts, ls.scene, verbose);  // environment_options.cpp
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {

@@ -25,7 +25,7 @@ void noteModeWithoutEnvironment(const Options& opts, const Scene& scene, bool ve
   const std::string mode = opts.get("--mode", "path");
   if (mode != "path" && scene.environment.emits())
     note(!verbose, "warning: the image will be black: --mode " + mode + " does not see the environment yet and " +
-                       scene.path + " has no emissive triangles (use --mode path)");
+                       scene.path + " has no emitters (use --mode path)");
 }
 }  // namespace
 
@@ -40,7 +40,7 @@ void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
     scene.environment = parseEnvironment(opts.get("--env", "none"), strength, rotation);
     if (!emitters && !scene.environment.emits())
       note(!verbose, "warning: the image will be black: " + scene.path +
-                         " has no emissive triangles and the environment emits nothing (--env " +
+                         " has no emitters (emissive triangles or punctual lights) and the environment emits nothing (--env " +
                          opts.get("--env", "") + ")");
     else if (!emitters)
       noteModeWithoutEnvironment(opts, scene, verbose);
@@ -50,14 +50,14 @@ void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
   scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance), strength);
   scene.environment.rotationDegrees = rotation;
   scene.environment.isDefault = true;
-  note(!verbose, scene.path + " has no emissive triangles: lit by the default environment, a uniform sky of radiance 1 "
+  note(!verbose, scene.path + " has no emitters (emissive triangles or punctual lights): lit by the default environment, a uniform sky of radiance 1 "
                               "(--env FILE|RGB to choose one, --env none for none)");
   noteModeWithoutEnvironment(opts, scene, verbose);
 }
 
 std::string lightingSummary(const Scene& scene, std::size_t emitterTriangles) {
-  std::string s = std::to_string(emitterTriangles) + " emitter triangle" + (emitterTriangles == 1 ? "" : "s") +
-                  ", environment " + scene.environment.describe();
+  std::string s = std::to_string(emitterTriangles) + " emitter triangle" + (emitterTriangles == 1 ? "" : "s") + ", " +
+                  std::to_string(scene.punctualLights.size()) + " punctual, environment " + scene.environment.describe();
   if (scene.background.kind != Background::Kind::Environment) s += ", background " + scene.background.describe();
   return s;
 }
@@ -65,6 +65,8 @@ std::string lightingSummary(const Scene& scene, std::size_t emitterTriangles) {
 std::string lightingTag(const Scene& scene, std::size_t emitterTriangles) {
   std::string s;
   if (emitterTriangles > 0) s = std::to_string(emitterTriangles) + " emitter tris";
+  if (!scene.punctualLights.empty())
+    s += (s.empty() ? "" : " + ") + std::to_string(scene.punctualLights.size()) + " punctual";
   const Environment& e = scene.environment;
   if (e.emits()) {
     std::string env = e.isDefault ? "env default (uniform 1)"

@@ -67,6 +67,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
+  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
   uploadCasters();
   lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
   Bounds sceneBounds;
@@ -209,6 +210,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
   environment_.bind();
+  punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested

@@ -102,6 +102,7 @@ class Renderer {
   GlBuffer pointLightUbo_;
   std::unique_ptr<RasterRenderer> raster_;  // built the first time the raster mode is used
   EnvironmentTextures environment_;  // environment map, CDFs and UBO
+  GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
   GlTexture accum_, comp_, display_;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/environment.h"
+#include "scene/punctual_lights.h"
 
 namespace caustica {
 
@@ -84,6 +85,8 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<Camera> cameras;       // perspective cameras in the default scene's node-visit order (may be empty)
   std::vector<std::string> warnings; // things skipped or approximated, each naming the file
+  std::vector<PunctualLight> punctualLights;  // KHR_lights_punctual instances (punctual_lights.h)
+  std::vector<SpotEmitter> spotEmitters;      // materials of spot lights made spheres by --light-radius
   Bounds bounds;
   // World-space position (glTF units, double) of this scene's float origin: for a scene farther from
   // the world origin than its own size, the loader subtracts its centre from every position and
@@ -95,8 +98,10 @@ struct Scene {
   Background background;
 };
 
-// Whether anything in the scene emits light: an emissive triangle or an environment that emits.
+// Whether anything in the scene emits light: an emissive material on a triangle, a punctual light or
+// an environment that emits.
 inline bool sceneHasLights(const Scene& s) {
+  if (!s.punctualLights.empty()) return true;
   for (const Triangle& t : s.triangles)
     if (t.material < s.materials.size() && s.materials[t.material].isEmissive()) return true;
   return s.environment.emits();

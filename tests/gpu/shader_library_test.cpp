@@ -101,6 +101,25 @@ TEST_CASE("every feature combination of pathtrace.comp compiles (glslang, GLSL 4
   }
 }
 
+TEST_CASE("the punctual-light variants compile on top of every integrator and material feature") {
+  // CAUSTICA_PUNCTUAL and CAUSTICA_SPOT_EMITTERS with each feature alone and with all of them (the
+  // full cross product with the features above would be 4x as many variants).
+  ShaderLibrary lib;
+  const auto& names = shaderFeatureNames();
+  std::vector<std::vector<std::string>> bases = {{}, names};
+  for (const auto& n : names) bases.push_back({n});
+  for (const auto& extra : std::vector<std::vector<std::string>>{
+           {"CAUSTICA_PUNCTUAL"}, {"CAUSTICA_SPOT_EMITTERS"}, {"CAUSTICA_PUNCTUAL", "CAUSTICA_SPOT_EMITTERS"}})
+    for (auto defines : bases) {
+      defines.insert(defines.end(), extra.begin(), extra.end());
+      std::string label;
+      for (const auto& d : defines) label += d + " ";
+      INFO("defines: ", label);
+      const std::string log = validate(lib.expand("pathtrace.comp", defines));
+      REQUIRE_MESSAGE(log.empty(), log);
+    }
+}
+
 TEST_CASE("the other entry shaders compile") {
   ShaderLibrary lib;
   for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/twins_test.comp", "tests/environment_test.comp"}) {
