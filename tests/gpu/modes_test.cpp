@@ -102,8 +102,10 @@ TEST_CASE("render modes: every mode renders every bundled scene") {
     // A scene without emitters (sun-glass) gets the default environment, as the command line gives
     // it; only the path tracer sees an environment so far (docs/lighting.md), so the raster and
     // Whitted images of such a scene are black and only checked for finite values.
-    const bool envOnly = !sceneHasLights(scene);
-    if (envOnly) scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
+    // The same holds for punctual lights (punctual-lights): raster and Whitted light with emissive triangles only.
+    if (!sceneHasLights(scene)) scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
+    bool envOnly = true;  // no emissive triangle: nothing the raster and Whitted modes light with
+    for (const Triangle& t : scene.triangles) envOnly = envOnly && !scene.materials[t.material].isEmissive();
     Camera cam = sceneCamera(scene);
     for (RenderMode mode : {RenderMode::Raster, RenderMode::Whitted, RenderMode::Path}) {
       INFO(name, " in mode ", renderModeName(mode));
