@@ -13,6 +13,9 @@
 #include "lib/microfacet.glsl"
 #include "lib/materials.glsl"
 #include "lib/lights.glsl"
+#ifdef CAUSTICA_ENV
+#include "lib/environment.glsl"
+#endif
 #if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
 #include "lib/punctual.glsl"
 #endif
@@ -29,6 +32,9 @@ shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samp
 uint gSecondaryRays = 0u;
 const uint kMaxPassThroughs = 256u;  // alpha pass-throughs a path may make beyond its bounces
 uint gShadowRays = 0u;
+#ifdef CAUSTICA_ENV
+#include "lib/environment_light.glsl"
+#endif
 
 #ifdef CAUSTICA_PUNCTUAL
 // Punctual-light next-event estimate at a non-delta vertex v (punctual.glsl): its own shadow ray, no
@@ -87,7 +93,12 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   for (uint depth = 0u; depth < maxDepth; ++depth) {
     if (depth + passThroughs > 0u) ++gSecondaryRays;
     Hit hit;
-    if (!traceClosest(org, dir, 3.0e38, hit)) break;
+    if (!traceClosest(org, dir, 3.0e38, hit)) {
+#ifdef CAUSTICA_ENV
+      radiance += beta * filt * escapedRadiance(dir, depth == 0u, prevDelta, prevPdf);  // environment_light.glsl
+#endif
+      break;
+    }
 #ifdef CAUSTICA_VOLUME
     beta *= exp(-sigma * hit.t);
 #endif
@@ -166,6 +177,15 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
         Vertex v = makeVertex(lambert, p, pError, ng, ns, dir, sigma, sigma);
         radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
       }
+#ifdef CAUSTICA_ENV
+      // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
+      // Not inside an absorbing medium: the ray could only leave through its boundary.
+      vec2 uEnv = rand2(rng);
+      if (depth + 1u < maxDepth && sigma == vec3(0.0)) {
+        Vertex ve = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
+        radiance += beta * filt * addEnvironmentLight(ve, uEnv);
+      }
+#endif
 #endif
 #ifdef CAUSTICA_PUNCTUAL
       // Punctual lights: their own estimate, added to the emitters' (a sum of unbiased estimates);
@@ -218,6 +238,13 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
       Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, metalRough.y, eta), p, pError, ng, ns, dir, sigma, sigmaBelow);
 #ifdef CAUSTICA_MIS
       if (depth + 1u < maxDepth) radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
+#endif
+#if defined(CAUSTICA_ENV) && defined(CAUSTICA_MIS)
+      // The environment's next-event estimate through this lobe (both sides for rough glass), matching
+      // the MIS weight escaped rays get after this vertex (environment_light.glsl).
+      vec2 uEnv = rand2(rng);
+      if (depth + 1u < maxDepth)
+        radiance += beta * filt * addEnvironmentLight(v, uEnv);
 #endif
 #ifdef CAUSTICA_PUNCTUAL
       float uPunctual = rand01(rng);

@@ -833,6 +833,38 @@ def small_cornell():
     return cornell_glass(segments=16, rings=8)
 
 
+def quat_look(direction):
+    """Rotation (x, y, z, w) turning a camera's -Z towards `direction` with no roll: yaw about y after
+    pitch about x."""
+    dx, dy, dz = normalize(direction)
+    yaw = math.atan2(-dx, -dz)
+    pitch = math.atan2(dy, math.hypot(dx, dz))
+    sy, cy = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+    sx, cx = math.sin(pitch / 2.0), math.cos(pitch / 2.0)
+    return [clean(cy * sx), clean(sy * cx), clean(-sy * sx), clean(cy * cx)]
+
+
+def sun_glass():
+    """A glass ball and a clay box on a grey floor, open to the sky: no emitters; meant for an
+    environment (render with --env sun-sky: assets/env/sun-sky.hdr, written by scripts/make_sky_hdr.py;
+    its sun stands 35 degrees high, in front of the camera and to the left, so the ball's shadow and
+    caustic fall to its right, towards the camera)."""
+    g = Gltf()
+    floor = g.material("floor", color=(0.7, 0.7, 0.7))
+    clay = g.material("clay", color=(0.75, 0.35, 0.2))
+    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
+                       thickness=1.0)
+    mesh = MeshData()
+    mesh.polygon([(-6, 0, -6), (6, 0, -6), (6, 0, 6), (-6, 0, 6)], (0, 1, 0))
+    g.object("floor", mesh, floor)
+    g.object("glass ball", uv_sphere(0.5, 64, 32), glass, translation=(0.0, 0.5, 0.0))
+    g.object("clay box", unit_cube(), clay, translation=(1.2, 0.3, -1.0), rotation=quat_y(25.0),
+             scale_=(0.6, 0.6, 0.6))
+    eye, target = (0.3, 1.8, 3.9), (0.45, 0.2, 0.2)
+    g.camera("camera", position=eye, yfov=0.6, rotation=quat_look(sub(target, eye)))
+    return g.finish()
+
+
 # ---- bad inputs ------------------------------------------------------------------------------------
 def triangle_doc(positions=None, indices=(0, 1, 2), mode=None, extra_accessor_count=None):
     """A minimal valid one-triangle scene, returned as a dict to be broken by the caller."""
@@ -1037,6 +1069,7 @@ def main():
         os.path.join(SCENES, "cornell-bunny-light.gltf"): cornell_bunny_light(),
         os.path.join(SCENES, "cornell-textured.gltf"): cornell_textured(),
         os.path.join(SCENES, "cornell-dispersion.gltf"): cornell_dispersion(),
+        os.path.join(SCENES, "sun-glass.gltf"): sun_glass(),
         os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
         os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
         os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),

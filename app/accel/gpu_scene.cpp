@@ -19,6 +19,7 @@ std::vector<std::string> SceneFeatures::defines() const {
   if (dispersion) d.push_back("CAUSTICA_DISPERSION");
   if (textures) d.push_back("CAUSTICA_TEXTURES");
   if (opacity) d.push_back("CAUSTICA_OPACITY");
+  if (environment) d.push_back("CAUSTICA_ENV");
   if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
   if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
   if (ggx) d.push_back("CAUSTICA_GGX");
@@ -36,6 +37,7 @@ std::string SceneFeatures::describe() const {
   add(dispersion, "dispersion");
   add(textures, "textures");
   add(opacity, "opacity");
+  add(environment, "environment");
   add(punctual, "punctual");
   add(spotEmitters, "spot-emitters");
   add(ggx, "ggx");
@@ -69,6 +71,7 @@ SceneFeatures sceneFeatures(const Scene& scene) {
     f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture;
     f.ggx |= hasRoughLobe(m);
   }
+  f.environment = scene.environment.emits() || scene.background.kind != Background::Kind::Environment;
   f.punctual = !scene.punctualLights.empty();
   for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
   return f;
@@ -113,6 +116,25 @@ std::uint32_t floatBits(float f) {
   std::memcpy(&u, &f, sizeof u);
   return u;
 }
+
+// The environment's texels, CDFs and UBO. An environment lights every point from everywhere, so
+// refractive casters are aimed at from every point: the sphere around the lights becomes one that
+// holds every point (its squared radius still finite in float).
+void packEnvironment(const Scene& scene, GpuScene& g) {
+  gpu::EnvironmentParams& p = g.environmentParams;
+  p.rotation = glm::vec4(1.0f, 0.0f, 0.0f, 0.0f);
+  if (scene.environment.emits()) {
+    g.environment = buildEnvironmentDistribution(scene.environment);
+    p.size = glm::uvec4(g.environment.width, g.environment.height, 0u, 0u);
+    p.rotation = glm::vec4(g.environment.cosRotation, g.environment.sinRotation, 0.0f, 0.0f);
+    g.emitterSphere = glm::vec4(0.5f * (scene.bounds.min + scene.bounds.max), 1.0e18f);
+  }
+  const Background& b = scene.background;
+  p.size.z = b.kind == Background::Kind::Color         ? gpu::kBackgroundColor
+             : b.kind == Background::Kind::Transparent ? gpu::kBackgroundTransparent
+                                                       : gpu::kBackgroundEnvironment;
+  p.background = glm::vec4(b.color, 0.0f);
+}
 }  // namespace
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh) {
@@ -120,6 +142,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   g.features = sceneFeatures(scene);
   g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
   g.emitterSphere = emitterBoundingSphere(scene);
+  packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triGeom = packTriGeom(scene.triangles, bvh);
   g.triShade.resize(bvh.order.size());

@@ -8,12 +8,14 @@
 #include "accel/bvh.h"
 #include "scene/caustic_casters.h"
 #include "scene/scene.h"
+#include "shading/environment_sampling.h"
 
 namespace caustica {
 
 // What the scene's materials need; each maps to one CAUSTICA_* shader define.
 struct SceneFeatures {
   bool mirror = false, glass = false, volume = false, dispersion = false, textures = false, opacity = false;
+  bool environment = false;  // an environment that emits, or a background other than it (CAUSTICA_ENV)
   bool punctual = false;      // KHR_lights_punctual lights: CAUSTICA_PUNCTUAL (their NEE, in both integrators)
   bool spotEmitters = false;  // --light-radius spheres of spot lights: CAUSTICA_SPOT_EMITTERS
   bool ggx = false;  // a rough metal or glass, or a specular layer over a diffuse base (CAUSTICA_GGX)
@@ -39,6 +41,9 @@ struct GpuScene {
   glm::vec4 emitterSphere{0.0f, 0.0f, 0.0f, -1.0f};  // around every emitter (emitterBoundingSphere)
   gpu::PunctualParams punctual{};       // punctual lights and their selection probabilities (a UBO)
   SceneFeatures features;
+  // The environment map and its sampling CDFs (width 0: no environment light).
+  EnvironmentDistribution environment;
+  gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
 };
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh);

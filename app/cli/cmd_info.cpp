@@ -6,6 +6,7 @@
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
+#include "cli/environment_options.h"
 #include "accel/bvh.h"
 #include "util/error.h"
 #include "accel/gpu_scene.h"
@@ -36,6 +37,7 @@ std::string vec(const glm::vec3& v) {
 
 int cmdInfo(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {{"--camera", "", "N", "describe the scene's N-th camera (default 0)"}};
+  for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   Options opts("caustica info SCENE [--camera N] [options]",
                "Prints triangles, emitters (count, total power), punctual lights, materials by kind, bounds, camera,\n"
@@ -55,6 +57,7 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("triangles:  %zu\n", s.triangles.size());
   std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitters.size(),
               g.totalPower);
+  std::printf("lighting:   %s\n", lightingSummary(s, g.emitters.size()).c_str());
   // KHR_lights_punctual, with their share of the light choices (by power, punctual_lights.h).
   std::printf("punctual:   %zu light(s)%s\n", s.punctualLights.size(),
               s.punctualLights.empty() ? "" : " (point/spot: intensity in cd; directional: lux; chosen by power)");

@@ -57,6 +57,8 @@ int cmdRender(const std::vector<std::string>& args) {
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
   if (opts.has("--light-radius")) settingsText += "light-radius " + opts.get("--light-radius", "") + "\n";  // changes the scene
+  settingsText += "environment " + ls.scene.environment.describe() + "\nbackground " + ls.scene.background.describe() +
+                  "\n";  // --env, --background change the image
   if (resumeFrom) {
     std::string diff = checkpointMismatch(*resumeFrom, sceneHash, settingsText);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);

@@ -106,6 +106,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   }
   pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
+  environment_.upload(g, limits_, scene.path);
   allocateImages();
   prepareMode();  // compile now, so shader errors surface before rendering starts
 }
@@ -121,7 +122,7 @@ void Renderer::prepareMode() {
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
-  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) {
+  if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
   }
@@ -237,6 +238,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
+  environment_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
 #include "accel/gpu_scene.h"
@@ -102,6 +103,7 @@ class Renderer {
   gpu::PointLights pointLights_{};
   GlBuffer pointLightUbo_;
   std::unique_ptr<RasterRenderer> raster_;  // built the first time the raster mode is used
+  EnvironmentTextures environment_;  // environment map, CDFs and UBO
   GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
   GlTexture accum_, comp_, display_;
   std::map<std::string, GlProgram> programs_;

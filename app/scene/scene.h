@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/environment.h"
 #include "scene/punctual_lights.h"
 
 namespace caustica {
@@ -108,14 +109,19 @@ struct Scene {
   // the world origin than its own size, the loader subtracts its centre from every position and
   // camera before converting to float, so it keeps full float precision; 0 for other scenes.
   glm::dvec3 origin{0.0};
+  // Light from infinity and what escaping camera rays see (scene/environment.h, docs/lighting.md).
+  // Set from the command line (--env, --background), not from the file.
+  Environment environment;
+  Background background;
 };
 
-// Whether anything in the scene emits light: an emissive material on a triangle or a punctual light.
+// Whether anything in the scene emits light: an emissive material on a triangle, a punctual light or
+// an environment that emits.
 inline bool sceneHasLights(const Scene& s) {
   if (!s.punctualLights.empty()) return true;
   for (const Triangle& t : s.triangles)
     if (t.material < s.materials.size() && s.materials[t.material].isEmissive()) return true;
-  return false;
+  return s.environment.emits();
 }
 
 // What loadScene accepts from a scene file it does not trust (docs/untrusted-input.md). Each limit

@@ -29,6 +29,9 @@ using uint = std::uint32_t;
 #define CAUSTICA_SSBO_COUNT 8         // SSBO bindings used by the path tracer
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
 #define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
+#define CAUSTICA_BINDING_ENVIRONMENT 3  // UBO: EnvironmentParams (environment map size, rotation, background)
+#define CAUSTICA_TEXUNIT_ENV_MAP 0      // texture unit: rgba32f environment map (rgb radiance, a conditional CDF)
+#define CAUSTICA_TEXUNIT_ENV_MARGINAL 1 // texture unit: rgba32f height x 1 (r: marginal CDF over rows)
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
@@ -61,6 +64,11 @@ CAUSTICA_CONST uint kMatAlphaMask = 16u;     // alphaMode MASK with a texture: o
 // FrameParams.options.w flags
 CAUSTICA_CONST uint kFlagMis = 1u;           // next-event estimation + MIS (else pure BSDF sampling)
 CAUSTICA_CONST uint kFlagSpectral = 2u;      // hero-wavelength dispersion (else one RGB channel per path)
+
+// EnvironmentParams.size.z: what camera rays that leave the scene see
+CAUSTICA_CONST uint kBackgroundEnvironment = 0u;  // the environment (black if there is none)
+CAUSTICA_CONST uint kBackgroundColor = 1u;        // EnvironmentParams.background.rgb
+CAUSTICA_CONST uint kBackgroundTransparent = 2u;  // nothing: radiance 0 and alpha 0
 
 // ---- SSBO structs ----------------------------------------------------------------------------
 // 32-byte BVH node: bounds and either two children (left, left+1) or a range of triangles.
@@ -148,6 +156,14 @@ struct CasterParams {
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
 };
 
+// The environment light (scene/environment.h; glsl/lib/environment.glsl), std140. Its texels and
+// CDFs live in two textures (CAUSTICA_TEXUNIT_ENV_*): no ninth SSBO.
+struct EnvironmentParams {
+  uvec4 size;        // x, y: map width and height in texels (0 = no environment); z: kBackground*; w unused
+  vec4 rotation;     // x, y: cos and sin of the map's rotation about +Y; zw unused
+  vec4 background;   // rgb: linear radiance camera rays see for kBackgroundColor; a unused
+};
+
 // The raster and Whitted modes light the scene with point lights: the emissive triangles grouped
 // into at most CAUSTICA_MAX_POINT_LIGHTS lights at their power-weighted centres (app/scene/light_groups.h).
 // Radiant intensity towards unit direction w (from the light): intensity.rgb * (max(0, dot(axis.xyz, w)) + position.w),
@@ -181,6 +197,7 @@ struct PunctualParams {
 };
 
 #ifdef __cplusplus
+static_assert(sizeof(EnvironmentParams) == 48, "EnvironmentParams must be 48 bytes (std140)");
 static_assert(sizeof(PointLight) == 64, "PointLight must be 64 bytes (std140)");
 static_assert(sizeof(PointLights) == 16 + 64 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
 static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <optional>
 
+#include "cli/environment_options.h"
 #include "image/image_io.h"
 #include "util/error.h"
 
@@ -184,7 +185,8 @@ void Viewer::updateTitle(bool force) {
   }
   lastTitle_ = t;
   const RenderSettings& wanted = controls_.wanted;
-  std::string title = "caustica view - " + sceneName_ + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
+  std::string title = "caustica view - " + sceneName_ + " | " +
+                      lightingTag(scene_.scene, renderer_->gpuScene().emitters.size()) + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
                       format("%.3g samples/s", samplesPerSecond_) + " | " + format("%.1f ms/frame", frameMs_) + " | " +
                       integratorName(wanted.integrator) +
                       (wanted.integrator == Integrator::Mis && !renderer_->gpuScene().casters.empty()
