@@ -72,6 +72,8 @@ class GlTexture {
   std::vector<float> readRgba32f() const;  // width*height*4 floats, row 0 first
   // Replaces every texel of an rgba32f texture with `rgba` (width*height*4 floats, row 0 first).
   void uploadRgba32f(const std::vector<float>& rgba);
+  // r32ui texture: writes `values` row by row from texel (0, 0), the last row padded with zeros.
+  void uploadR32uiRows(const std::vector<std::uint32_t>& values);
   int width() const { return width_; }
   int height() const { return height_; }
   GLuint id() const { return handle_.id(); }
