@@ -18,7 +18,7 @@ const ErrorEstimate& AdaptiveSampler::check(Renderer& renderer) {
   estimate_ = renderer.errorEstimate();
   liveTiles_ = renderer.liveTileCount();
   if (adaptive_) {
-    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, kTileTargetFraction * target_, minSpp_, kTileDilation);
+    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, kMaxSppRatio, kTileDilation);
     renderer.setLiveTiles(live);
     liveTiles_ = live.size();
   }

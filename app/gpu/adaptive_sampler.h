@@ -10,25 +10,20 @@
 namespace caustica {
 
 constexpr int kMinAdaptiveSpp = 16;  // no tile stops before every pixel has this many samples
-constexpr int kTileDilation = 1;     // live tiles keep their 8 neighbours live
-// A tile stops once its estimate is below this fraction of the image's target; the render stops once
-// the image's estimate reaches the target. Stopping tiles at the target itself would equalise the
-// error (the minimax allocation), which spends as much as uniform sampling on the mean error; the
-// mean error is least for samples proportional to each tile's standard deviation, which stopping at
-// half the target approaches for images whose noise is concentrated (docs/adaptive-sampling.md).
-constexpr double kTileTargetFraction = 0.5;
+constexpr int kTileDilation = 1;     // a tile with over 4x the mean gain keeps its 8 neighbours live
+constexpr int kMaxSppRatio = 8;      // no tile falls behind the most sampled one by more than this factor
 
 class AdaptiveSampler {
  public:
-  // `targetError`: relMSE at which the render is done (> 0), `adaptive`: whether tiles below the
-  // tile target stop receiving samples (else the whole image keeps sampling until the target).
+  // `targetError`: relMSE at which the render is done (> 0), `adaptive`: whether only the tiles whose
+  // error falls fastest receive samples (liveTiles in error_estimate.h), else every tile does.
   AdaptiveSampler(double targetError, bool adaptive, int minSpp = kMinAdaptiveSpp);
 
   // The first scheduled check at `spp` or above: minSpp, then each previous one + max(4, previous / 8).
   int checkAtOrAfter(int spp) const;
   // Estimates the error of `renderer`'s image and, when adaptive, sets its live tiles.
   const ErrorEstimate& check(Renderer& renderer);
-  // After a check: the image estimate reached the target, or no tile is live any more.
+  // After a check: the image estimate reached the target.
   bool done() const { return done_; }
   const ErrorEstimate& estimate() const { return estimate_; }
   std::size_t liveTiles() const { return liveTiles_; }

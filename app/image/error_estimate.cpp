@@ -89,21 +89,36 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   return e;
 }
 
-std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, double threshold, int minSpp, int dilation) {
-  std::vector<char> live(e.tile.size(), 0), grown(e.tile.size(), 0);
-  for (size_t t = 0; t < e.tile.size(); ++t)
-    live[t] = e.tileSppMin[t] < minSpp || !(e.tile[t] <= threshold);  // NaN and +inf stay live
+std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int maxSppRatio, int dilation) {
+  const size_t tiles = e.tile.size();
+  std::vector<double> gain(tiles);
+  double meanGain = 0.0;
+  int mostSpp = 0, finite = 0;
+  for (size_t t = 0; t < tiles; ++t) {
+    gain[t] = e.tile[t] / std::max(e.tileSppMin[t], 1);
+    if (std::isfinite(gain[t])) {
+      meanGain += gain[t];
+      ++finite;
+    }
+    mostSpp = std::max(mostSpp, e.tileSppMin[t]);
+  }
+  // Slightly below the mean, so that tiles of equal gain all count as "at the mean" despite rounding.
+  meanGain = meanGain / std::max(finite, 1) * (1.0 - 1e-9);
+  std::vector<char> live(tiles, 0);
   for (int ty = 0; ty < e.tilesY; ++ty)
     for (int tx = 0; tx < e.tilesX; ++tx) {
-      if (!live[static_cast<size_t>(ty) * e.tilesX + tx]) continue;
-      for (int y = std::max(0, ty - dilation); y <= std::min(e.tilesY - 1, ty + dilation); ++y)
-        for (int x = std::max(0, tx - dilation); x <= std::min(e.tilesX - 1, tx + dilation); ++x)
-          grown[static_cast<size_t>(y) * e.tilesX + x] = 1;
+      const size_t t = static_cast<size_t>(ty) * e.tilesX + tx;
+      const bool behind = e.tileSppMin[t] < minSpp || static_cast<double>(e.tileSppMin[t]) * maxSppRatio < mostSpp;
+      if (behind || !(gain[t] < meanGain) || !std::isfinite(gain[t])) live[t] = 1;
+      if (!(gain[t] <= 4.0 * meanGain))
+        for (int y = std::max(0, ty - dilation); y <= std::min(e.tilesY - 1, ty + dilation); ++y)
+          for (int x = std::max(0, tx - dilation); x <= std::min(e.tilesX - 1, tx + dilation); ++x)
+            live[static_cast<size_t>(y) * e.tilesX + x] = 1;
     }
   std::vector<std::uint32_t> out;
   for (int ty = 0; ty < e.tilesY; ++ty)
     for (int tx = 0; tx < e.tilesX; ++tx)
-      if (grown[static_cast<size_t>(ty) * e.tilesX + tx])
+      if (live[static_cast<size_t>(ty) * e.tilesX + tx])
         out.push_back(static_cast<std::uint32_t>(tx) | (static_cast<std::uint32_t>(ty) << 16));
   return out;
 }

@@ -38,10 +38,15 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
 double pixelChannelVariance(double sumA, double nA, double sumB, double nB);
 double pixelChannelRelMse(double sumA, double nA, double sumB, double nB);
 
-// Adaptive sampling: the tiles that still receive samples, packed x | y << 16 (row-major order).
-// A tile is live while any pixel has fewer than `minSpp` samples or its estimate exceeds `threshold`;
-// every tile within `dilation` tiles (8-neighbourhood) of a live tile is live too, so that a noisy
-// region's neighbours, whose few samples may have missed the rare paths, are not starved.
-std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, double threshold, int minSpp, int dilation);
+// Adaptive sampling: the tiles that receive the next samples, packed x | y << 16 (row-major order).
+// The mean relMSE over the image falls fastest by sampling the tiles whose error falls most per sample:
+// with e = v / n, -de/dn = e / n, the tile's "gain". Tiles whose gain is at least the mean gain over
+// all tiles are live; sampling lowers their gain (as 1/n^2) until the paused ones are ahead again, so
+// the allocation tends to n proportional to each tile's standard deviation, the allocation with the
+// least mean error for a given number of samples. Guards against starving a tile whose few samples
+// missed rare paths: a tile with fewer than `minSpp` samples, or less than 1/`maxSppRatio` of the most
+// sampled tile's, is live whatever its estimate; a tile whose gain is over 4x the mean makes its
+// neighbours within `dilation` tiles live (they may share its rare paths). NaN and +inf are live.
+std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, int minSpp, int maxSppRatio, int dilation);
 
 }  // namespace caustica

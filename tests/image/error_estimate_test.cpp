@@ -60,7 +60,7 @@ TEST_CASE("error estimate: a pixel with an empty half is unknown (infinite), nev
   Synthetic s = synthetic(8, 8, 1, 1.0, 0.1, 3u);
   ErrorEstimate e = estimateError(8, 8, s.accum, s.comp, s.half, 8);
   CHECK(std::isinf(e.image));
-  CHECK(liveTiles(e, 1e30, 0, 0).size() == 1);
+  CHECK(liveTiles(e, 0, 8, 0).size() == 1);
   CHECK(std::isinf(pixelChannelRelMse(1.0, 1.0, 0.0, 0.0)));
   // Equal halves: zero; halves 1 and 3 from one sample each: var(mean) = (1 - 3)^2 / 4 = 1, m = 2.
   CHECK(pixelChannelVariance(1.0, 1.0, 3.0, 1.0) == 1.0);
@@ -68,22 +68,37 @@ TEST_CASE("error estimate: a pixel with an empty half is unknown (infinite), nev
   CHECK(std::abs(pixelChannelRelMse(1.0, 1.0, 3.0, 1.0) - 1.0 / (4.0 + kErrorEpsilon)) < 1e-12);
 }
 
-TEST_CASE("live tiles: threshold, minimum spp and dilation to the 8 neighbours") {
+TEST_CASE("live tiles: the tiles whose error falls fastest per sample, with starvation guards") {
   ErrorEstimate e;
   e.tileSize = 8;
   e.tilesX = 5;
   e.tilesY = 4;
   e.tile.assign(20, 0.001);
   e.tileSppMin.assign(20, 32);
-  e.tile[2 * 5 + 2] = 0.5;  // one noisy tile at (2, 2)
-  auto live = liveTiles(e, 0.01, 16, 1);
-  CHECK(live.size() == 9);  // it and its 8 neighbours
+  auto at = [&](int x, int y) { return static_cast<size_t>(y) * 5 + x; };
+  // Equal gains: every tile is at the mean, all live (uniform sampling).
+  CHECK(liveTiles(e, 16, 8, 1).size() == 20);
+  // One tile with a high gain (0.5 / 32, far above 4x the mean): it and its 8 neighbours.
+  e.tile[at(2, 2)] = 0.5;
+  auto live = liveTiles(e, 16, 8, 1);
+  CHECK(live.size() == 9);
   CHECK(live.front() == (1u | (1u << 16)));
   CHECK(live.back() == (3u | (3u << 16)));
-  CHECK(liveTiles(e, 0.01, 16, 0).size() == 1);
-  CHECK(liveTiles(e, 1.0, 16, 1).empty());
-  e.tileSppMin[0] = 8;  // below the minimum: live whatever its estimate
-  CHECK(liveTiles(e, 1.0, 16, 0).size() == 1);
+  CHECK(liveTiles(e, 16, 8, 0).size() == 1);
+  // Gain is error per sample: the same error with 4x the samples no longer leads.
+  e.tile[at(2, 2)] = 0.002;
+  e.tile[at(0, 0)] = 0.01;
+  e.tileSppMin[at(2, 2)] = 128;
+  live = liveTiles(e, 16, 8, 0);
+  CHECK(live.size() == 1);
+  CHECK(live[0] == 0u);
+  // Guards: below the minimum spp, or more than 8x behind the most sampled tile: live.
+  e.tileSppMin[at(4, 3)] = 8;
+  CHECK(liveTiles(e, 16, 8, 0).size() == 2);
+  e.tileSppMin[at(4, 3)] = 32;
+  e.tileSppMin[at(2, 2)] = 257;  // every 32-spp tile is more than 8x behind
+  CHECK(liveTiles(e, 16, 8, 0).size() == 19);
+  e.tileSppMin[at(2, 2)] = 128;
   e.tile[19] = std::nan("");
-  CHECK(liveTiles(e, 1.0, 0, 0).size() == 1);  // NaN is never "below the target"
+  CHECK(liveTiles(e, 16, 8, 0).size() == 2);  // NaN is never "below"
 }
