@@ -33,12 +33,14 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   e.tileSppMin.assign(e.tile.size(), std::numeric_limits<int>::max());
   std::vector<int> tilePixels(e.tile.size(), 0);
   if (pixels == 0 || accum.size() < pixels * 4 || comp.size() < pixels * 4 || half.size() < pixels * 4) return e;
-  // Pixel means first. The denominator uses the mean of the pixel's 8 neighbours, not the pixel's own
-  // mean m: m is correlated with (mA - mB)^2 (a bright outlier raises both), and Var / (m^2 + eps)
-  // then underestimates the relMSE of skewed pixels (measured on the Cornell box at 32x32: 0.58x at
-  // 8 spp with m, 0.71x with the 3x3 mean including the pixel, 1.03x with the 8 neighbours; a 5x5
-  // window overestimates at edges: 1.8x at 128 spp on 24x24).
-  std::vector<double> mean(pixels * 3), var(pixels * 3);
+  // Pixel means first. The denominator is the median of three estimates of the pixel's true mean:
+  // its own mean m (correlated with (mA - mB)^2: a bright outlier raises both, and alone it
+  // underestimates skewed pixels, 0.58x at 8 spp on the Cornell box at 24x24), the mean of its 8
+  // neighbours (independent of its samples, but wrong at edges: a caustic pixel among dark ones is
+  // overestimated 1.7-7.7x, a dark pixel beside the light underestimated ~0.75x) and the lower of its
+  // two half means (an outlier sits in one half only; biased low by the halves' noise). Each is wrong
+  // in a different case, and in each case the other two agree (docs/adaptive-sampling.md).
+  std::vector<double> mean(pixels * 3), var(pixels * 3), lowHalf(pixels * 3);
   std::vector<int> count(pixels);
   for (size_t i = 0; i < pixels; ++i) {
     const float* a = &accum[i * 4];
@@ -50,6 +52,7 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
     for (int ch = 0; ch < 3; ++ch) {
       const double total = double(a[ch]) - double(c[ch]);
       mean[i * 3 + ch] = n > 0.0 ? total / n : 0.0;
+      lowHalf[i * 3 + ch] = nA > 0.0 && nB > 0.0 ? std::min((total - b[ch]) / nA, double(b[ch]) / nB) : 0.0;
       var[i * 3 + ch] = pixelChannelVariance(total - b[ch], nA, b[ch], nB);
     }
   }
@@ -69,6 +72,9 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
               ++k;
             }
         m /= std::max(k, 1);
+        // Median of three: own mean, neighbours' mean, the lower half's mean (see above).
+        const double own = mean[i * 3 + ch], low = lowHalf[i * 3 + ch];
+        m = std::max(std::min(own, m), std::min(std::max(own, m), low));
         rel += var[i * 3 + ch] / (m * m + kErrorEpsilon);
       }
       rel /= 3.0;
