@@ -195,7 +195,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   fp.camUp = glm::vec4(up * tanHalf, 0.0f);
   fp.camForward = glm::vec4(fwd, 0.0f);
   fp.tile = glm::uvec4(0, y0, w, y1 - y0);
-  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 1.0f, 0.0f, 0.0f);
+  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 0.0f, 0.0f, 0.0f);
 
   prog.use();
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
@@ -222,9 +222,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   for (int s = 0; s < spp; ++s) {
     if (s > 0 && s % dispatchesPerRead == 0) readCounters();
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(),
-                            (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
-                                (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), 0u);
     frameUbo_.update(0, sizeof fp, &fp);
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);

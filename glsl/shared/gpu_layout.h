@@ -47,10 +47,6 @@ CAUSTICA_CONST uint kMatDoubleSided = 1u;
 CAUSTICA_CONST uint kMatHasVolume = 2u;      // Beer–Lambert absorption inside (KHR_materials_volume)
 CAUSTICA_CONST uint kMatDispersive = 4u;     // KHR_materials_dispersion with dispersion > 0
 
-// FrameParams.options.w flags
-CAUSTICA_CONST uint kFlagMis = 1u;           // next-event estimation + MIS (else pure BSDF sampling)
-CAUSTICA_CONST uint kFlagSpectral = 2u;      // hero-wavelength dispersion (else one RGB channel per path)
-
 // ---- SSBO structs ----------------------------------------------------------------------------
 // 32-byte BVH node: bounds and either two children (left, left+1) or a range of triangles.
 struct BvhNode {
@@ -117,9 +113,10 @@ struct FrameParams {
   vec4 camForward;  // xyz: unit viewing direction
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
   uvec4 options;    // x: max depth, y: live tiles in the tile list (0: the dispatch covers `tile`; else one
-                    //    8x8 work group per listed tile, adaptive sampling), z: emitter count, w: kFlag* bits
+                    //    8x8 work group per listed tile, adaptive sampling), z: emitter count, w: unused (the integrator
+                    //    and dispersion mode are shader variants, not flags)
   uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
-  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); y: exposure (display); zw unused
+  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); yzw unused
 };
 
 // Caustic casters: bounding spheres of the scene's specular objects (glass, mirrors), aimed at from
