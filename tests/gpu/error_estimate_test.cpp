@@ -63,19 +63,19 @@ TEST_CASE("error estimate: agrees with the relMSE against a reference (Cornell b
     CHECK(p.ratio() == Rel(1.0, 0.25));
 }
 
-// The figures of docs/benchmarks.md ("Error estimate"): every bundled scene, three sample counts.
-// Diffuse scenes: within 25 % at every count. Caustic scenes (glass, dispersion): heavy-tailed; at low
-// spp most caustic pixels have not yet seen the rare paths that make their mean, and no estimate from
-// the image's own samples knows that mean: measured 1.7x (glass) and 7x (dispersion) at 8 spp on
-// 24x24, 0.7-1.3x at 128 spp. They are held to a factor 2 from 32 spp on (a known gap: see
+// The figures of docs/benchmarks.md ("Error estimate"): every bundled scene, three sample counts,
+// 32x32. Measured ratios (estimated / measured): diffuse scenes 0.97-1.09, cornell-glass 0.95-1.14,
+// all within 25 %. cornell-dispersion 1.63, 1.38, 1.23 at 8, 32, 128 spp: heavy-tailed (at low spp
+// most caustic pixels have not yet seen the rare paths that make their mean, and no estimate from the
+// image's own samples knows that mean); held to 25 % at 128 spp and a factor 2 below (a known gap:
 // docs/adaptive-sampling.md).
 TEST_CASE("stress: error estimate on every bundled scene") {
   for (const char* name : {"cornell-box", "cornell-textured", "cornell-bunny-light", "cornell-glass", "cornell-dispersion"}) {
-    const bool caustic = std::string(name) == "cornell-glass" || std::string(name) == "cornell-dispersion";
+    const bool dispersive = std::string(name) == "cornell-dispersion";
     for (const EstimatePoint& p :
          estimateAgainstReference(std::string("assets/scenes/") + name + ".gltf", 32, 32, {8, 32, 128}, 2048)) {
-      if (!caustic) CHECK(p.ratio() == Rel(1.0, 0.25));
-      else if (p.spp >= 32) CHECK((p.ratio() > 0.5 && p.ratio() < 2.0));
+      if (!dispersive || p.spp >= 128) CHECK(p.ratio() == Rel(1.0, 0.25));
+      else CHECK((p.ratio() > 0.5 && p.ratio() < 2.0));
     }
   }
 }
