@@ -24,8 +24,7 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--spp", "", "N", "samples per pixel, a cap (default 64; with --time or --target-error: 65536)"},
       {"--time", "", "SECONDS", "stop after about SECONDS (whichever of --spp, --time, --target-error comes first)"},
       {"--target-error", "", "E",
-       "stop once the estimated relMSE of the image is at most E; tiles already well below it stop\n"
-       "receiving samples (adaptive sampling; docs/adaptive-sampling.md)"},
+       "stop once the estimated relMSE of the image is at most E; samples go to the tiles whose error falls fastest (adaptive sampling)"},
       {"--uniform", "", "", "with --target-error: keep sampling every pixel (no adaptive sampling)"},
       {"--stats", "", "FILE.json",
        "write seconds, spp_min, spp_mean, spp_max, estimated_relmse, nonfinite_samples, rays, samples"},
