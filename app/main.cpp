@@ -1,4 +1,4 @@
-// main.cpp — the caustica command line: render / info / view / bench subcommands.
+// main.cpp — the caustica command line: render / info / view / bench / compare subcommands.
 // Setup errors are exceptions, caught here once and printed as one line with a non-zero exit.
 #include <cstring>
 #include <iostream>
@@ -21,6 +21,7 @@ const char* kUsage =
     "  view [SCENE]     interactive progressive preview in a window\n"
     "  info SCENE       print what a scene holds and what the renderer will need for it\n"
     "  bench [SCENE..]  measure run time against error for each estimator\n"
+    "  compare [SCENE]  raster, Whitted and path tracing side by side with the table of effects\n"
     "\n"
     "SCENE is a .gltf/.glb file or the name of a bundled scene (default: cornell-glass).\n"
     "'caustica <command> --help' describes each command's options.\n";
@@ -44,7 +45,8 @@ int main(int argc, char** argv) {
     if (command == "info") return caustica::cli::cmdInfo(args);
     if (command == "view") return caustica::cli::cmdView(args);
     if (command == "bench") return caustica::cli::cmdBench(args);
-    std::cerr << "caustica: unknown command '" << command << "' (commands: render, view, info, bench; see --help)\n";
+    if (command == "compare") return caustica::cli::cmdCompare(args);
+    std::cerr << "caustica: unknown command '" << command << "' (commands: render, view, info, bench, compare; see --help)\n";
     return 2;
   } catch (const caustica::Error& e) {
     std::string msg = e.what();

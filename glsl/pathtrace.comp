@@ -12,6 +12,9 @@
 #include "lib/spectral.glsl"
 #include "lib/materials.glsl"
 #include "lib/lights.glsl"
+#if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
+#include "lib/punctual.glsl"
+#endif
 #ifdef CAUSTICA_CASTERS
 #include "lib/casters.glsl"
 #endif
@@ -25,6 +28,24 @@ shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samp
 uint gSecondaryRays = 0u;
 const uint kMaxPassThroughs = 256u;  // alpha pass-throughs a path may make beyond its bounces
 uint gShadowRays = 0u;
+
+#ifdef CAUSTICA_PUNCTUAL
+// The diffuse lobe's BSDF value times cos at wi (ns: shading normal on the path's side); a new lobe
+// evaluates its own here, so the light estimators below serve every non-delta vertex alike.
+vec3 diffuseBsdfCos(vec3 albedo, vec3 ns, vec3 wi) { return albedo * (INV_PI * max(dot(ns, wi), 0.0)); }
+
+// Punctual-light next-event estimate at a non-delta vertex (punctual.glsl): its own shadow ray,
+// no MIS (a delta light cannot be hit by a bounce). sigma: absorption of the medium the vertex is in.
+vec3 addPunctualLight(vec3 p, vec3 pError, vec3 ng, vec3 ns, vec3 albedo, vec3 sigma, float u) {
+  vec3 wi, li;
+  float dist;
+  if (!samplePunctualLight(p, pError, ng, u, wi, li, dist, gShadowRays)) return vec3(0.0);
+#ifdef CAUSTICA_VOLUME
+  if (any(greaterThan(sigma, vec3(0.0)))) li *= exp(-sigma * dist);
+#endif
+  return diffuseBsdfCos(albedo, ns, wi) * li;
+}
+#endif
 
 // One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
 vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
@@ -71,6 +92,9 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     // Emission, weighted against light sampling when the last bounce could have sampled it.
     if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) {
       float w = 1.0;
+#ifdef CAUSTICA_SPOT_EMITTERS
+      w *= spotEmitterFactor(m, -dir);  // a --light-radius sphere of a spot light emits into its cone
+#endif
 #ifdef CAUSTICA_MIS
       if (!prevDelta) {
         float pdfLight = lightPdfArea(m) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
@@ -145,10 +169,19 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_VOLUME
             transmittance = exp(-sigma * dist);  // the shadow ray runs inside the same medium
 #endif
+#ifdef CAUSTICA_SPOT_EMITTERS
+            ls.le *= spotEmitterFactor(materials[ls.material], -wl);
+#endif
             radiance += beta * filt * base.rgb * (INV_PI * cosSurf * w / pdfLight) * ls.le * transmittance;
           }
         }
       }
+#endif
+#ifdef CAUSTICA_PUNCTUAL
+      // Punctual lights: their own estimate, added to the emitters' (a sum of unbiased estimates);
+      // in both integrators, since a bounce never finds a delta light.
+      float uPunctual = rand01(rng);
+      if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(p, pError, ng, ns, base.rgb, sigma, uPunctual);
 #endif
 #ifdef CAUSTICA_CASTERS
       float cosOut = dot(newDir, ns);

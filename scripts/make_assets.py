@@ -676,6 +676,110 @@ def curved_light_box(name, mesh, area, double_sided, height, description, area_k
     return doc
 
 
+def look_rotation(direction):
+    """Unit quaternion (x, y, z, w) turning a node's -Z towards `direction`, without roll: a yaw about
+    +y, then a pitch about the node's x axis (for cameras and KHR_lights_punctual lights)."""
+    d = normalize(direction)
+    yaw = math.atan2(-d[0], -d[2])
+    pitch = math.asin(max(-1.0, min(1.0, d[1])))
+    cy, sy = math.cos(yaw / 2.0), math.sin(yaw / 2.0)
+    cp, sp = math.cos(pitch / 2.0), math.sin(pitch / 2.0)
+    # q_yaw * q_pitch with q_yaw = (0, sy, 0, cy), q_pitch = (sp, 0, 0, cp)
+    return [clean(cy * sp, 9), clean(sy * cp, 9), clean(-sy * sp, 9), clean(cy * cp, 9)]
+
+
+def add_punctual_light(g, name, light, position=None, direction=None):
+    """A KHR_lights_punctual light and a root node placing it (the light shines down the node's -Z)."""
+    ext = g.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})
+    ext["lights"].append(dict(light, name=name))
+    g.extensions.add("KHR_lights_punctual")
+    node = {"name": name, "extensions": {"KHR_lights_punctual": {"light": len(ext["lights"]) - 1}}}
+    if position is not None:
+        node["translation"] = [clean(x) for x in position]
+    if direction is not None:
+        node["rotation"] = look_rotation(direction)
+    g.doc["nodes"].append(node)
+    g.doc["scenes"][0]["nodes"].append(len(g.doc["nodes"]) - 1)
+
+
+def punctual_lights_scene():
+    """A table-top stage lit only by KHR_lights_punctual lights: a warm point light, a cool spot aimed
+    at a glass ball and a low sun. Intensities in the spec's units (cd; the sun in lux). The ball's
+    caustic of the point and spot lights appears only with --light-radius (a delta light cannot be
+    found by a bounce off the floor through the glass)."""
+    g = Gltf()
+    floor_mesh = MeshData()
+    floor_mesh.polygon([(-3, 0, -2), (3, 0, -2), (3, 0, 3), (-3, 0, 3)], (0, 1, 0))
+    wall_mesh = MeshData()
+    wall_mesh.polygon([(-3, 3, -2), (3, 3, -2), (3, 0, -2), (-3, 0, -2)], (0, 0, 1))
+    white = g.material("white", color=WHITE)
+    g.object("floor", floor_mesh, white)
+    g.object("back wall", wall_mesh, white)
+    radius = 0.35
+    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
+                       thickness=2 * radius)
+    g.object("glass ball", uv_sphere(radius, 48, 24), glass, translation=(0.15, radius, 0.2))
+    red = g.material("red", color=RED)
+    g.object("box", unit_cube(), red, translation=(-0.85, 0.25, -0.45), rotation=quat_y(25.0),
+             scale_=(0.5, 0.5, 0.5))
+    green = g.material("green", color=GREEN)
+    g.object("green ball", uv_sphere(0.25, 32, 16), green, translation=(1.0, 0.25, -0.6))
+    add_punctual_light(g, "warm bulb", {"type": "point", "color": [1.0, 0.75, 0.5], "intensity": 1.5},
+                       position=(-1.1, 1.1, 0.9))
+    spot_at = (1.3, 2.0, 1.1)
+    add_punctual_light(g, "cool spot", {"type": "spot", "color": [0.65, 0.8, 1.0], "intensity": 12.0,
+                                        "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.32}},
+                       position=spot_at, direction=sub((0.15, radius, 0.2), spot_at))
+    add_punctual_light(g, "low sun", {"type": "directional", "color": [1.0, 0.9, 0.75], "intensity": 0.6},
+                       direction=(0.6, -0.45, -0.65))
+    cam_at = (0.0, 1.35, 3.3)
+    g.camera("camera", cam_at, 0.75, aspect=1.0, rotation=look_rotation(sub((0.0, 0.35, 0.0), cam_at)))
+    return g.finish()
+
+
+def many_lights_scene(count=31, spacing=1.3, size=0.25, height=0.6):
+    """A floor under a count x count grid of small emissive quads (961 lights, 1,922 emissive
+    triangles), spread far apart, with boxes among them: every floor point is lit by its few nearest
+    lights, while power-proportional light selection picks one of those only rarely. For measuring
+    light selection (docs/path-tracer.md, "Many lights")."""
+    g = Gltf()
+    half = (count - 1) * spacing / 2.0 + 2.0
+    floor_mesh = MeshData()
+    floor_mesh.polygon([(-half, 0, -half), (half, 0, -half), (half, 0, half), (-half, 0, half)], (0, 1, 0))
+    white = g.material("white", color=WHITE)
+    g.object("floor", floor_mesh, white)
+    lights = MeshData()
+    h = size / 2.0
+    for i in range(count):
+        for j in range(count):
+            x = (i - (count - 1) / 2.0) * spacing
+            z = (j - (count - 1) / 2.0) * spacing
+            lights.polygon([(x - h, height, z - h), (x + h, height, z - h), (x + h, height, z + h),
+                            (x - h, height, z + h)], (0, -1, 0))
+    lamp = g.material("lamp", color=(0.8, 0.8, 0.8), emissive=(1.0, 0.9, 0.75), strength=20.0)
+    g.object("lights", lights, lamp)
+    boxes = MeshData(with_uvs=True)
+    cube = unit_cube()
+    state = 12345
+    for k in range(40):  # a fixed linear congruential sequence: the same boxes on every run
+        vals = []
+        for _ in range(3):
+            state = (1103515245 * state + 12345) % 2147483648
+            vals.append(state / 2147483648.0)
+        cx = (vals[0] - 0.5) * 2.0 * (half - 2.0)
+        cz = (vals[1] - 0.5) * 2.0 * (half - 2.0)
+        s = 0.2 + 0.25 * vals[2]
+        base = len(boxes.positions)
+        for p, n, uv in zip(cube.positions, cube.normals, cube.uvs):
+            boxes.vertex((cx + p[0] * s, s / 2.0 + p[1] * s, cz + p[2] * s), n, uv)
+        boxes.indices += [base + i for i in cube.indices]
+    red = g.material("red", color=RED)
+    g.object("boxes", boxes, red)
+    cam_at = (0.0, 2.2, 7.0)
+    g.camera("camera", cam_at, 0.8, aspect=1.0, rotation=look_rotation(sub((0.0, 0.0, 0.0), cam_at)))
+    return g.finish()
+
+
 def far_small_cornell():
     """small_cornell with its whole node tree (camera included) moved by (1e6, -2e6, 5e5): the loader
     rebases it in double, and `caustica info` prints that origin (test scene)."""
@@ -908,6 +1012,8 @@ def main():
         os.path.join(SCENES, "cornell-bunny-light.gltf"): cornell_bunny_light(),
         os.path.join(SCENES, "cornell-textured.gltf"): cornell_textured(),
         os.path.join(SCENES, "cornell-dispersion.gltf"): cornell_dispersion(),
+        os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
+        os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),

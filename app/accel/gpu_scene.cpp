@@ -17,6 +17,8 @@ std::vector<std::string> SceneFeatures::defines() const {
   if (dispersion) d.push_back("CAUSTICA_DISPERSION");
   if (textures) d.push_back("CAUSTICA_TEXTURES");
   if (opacity) d.push_back("CAUSTICA_OPACITY");
+  if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
+  if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
   return d;
 }
 
@@ -31,6 +33,8 @@ std::string SceneFeatures::describe() const {
   add(dispersion, "dispersion");
   add(textures, "textures");
   add(opacity, "opacity");
+  add(punctual, "punctual");
+  add(spotEmitters, "spot-emitters");
   return s.empty() ? "diffuse only" : s;
 }
 
@@ -51,6 +55,8 @@ SceneFeatures sceneFeatures(const Scene& scene) {
     f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
     f.opacity |= m.baseColor.a < 1.0f;
   }
+  f.punctual = !scene.punctualLights.empty();
+  for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
   return f;
 }
 
@@ -123,6 +129,15 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
                         flags, 0u);
     g.materials.push_back(gm);
   }
+  for (const SpotEmitter& e : scene.spotEmitters) {  // --light-radius spheres of spot lights
+    if (e.material >= g.materials.size()) continue;
+    gpu::Material& gm = g.materials[e.material];
+    gm.absorption = glm::vec4(e.axis, e.cosOuter);
+    gm.emission.w = e.cosInner;
+    gm.tex.z |= gpu::kMatSpotEmitter;
+  }
+  g.punctual = packPunctualLights(scene.punctualLights, scene.bounds, scene.path);
+  g.features.punctual = g.punctual.count.x > 0;
 
   for (const Texture& t : scene.textures) {
     gpu::TexInfo info{};

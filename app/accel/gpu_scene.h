@@ -14,6 +14,8 @@ namespace caustica {
 // What the scene's materials need; each maps to one CAUSTICA_* shader define.
 struct SceneFeatures {
   bool mirror = false, glass = false, volume = false, dispersion = false, textures = false, opacity = false;
+  bool punctual = false;      // KHR_lights_punctual lights: CAUSTICA_PUNCTUAL (their NEE, in both integrators)
+  bool spotEmitters = false;  // --light-radius spheres of spot lights: CAUSTICA_SPOT_EMITTERS
   std::vector<std::string> defines() const;  // material defines only (not integrator or dispersion mode)
   std::string describe() const;              // e.g. "mirror glass dispersion" or "diffuse only"
 };
@@ -31,6 +33,7 @@ struct GpuScene {
   double totalPower = 0.0;              // emitted power, pi * luminance * area * sides (scene units)
   std::vector<CausticCaster> casters;   // caustic casters (findCausticCasters), at most CAUSTICA_MAX_CASTERS
   glm::vec4 emitterSphere{0.0f, 0.0f, 0.0f, -1.0f};  // around every emitter (emitterBoundingSphere)
+  gpu::PunctualParams punctual{};       // punctual lights and their selection probabilities (a UBO)
   SceneFeatures features;
 };
 

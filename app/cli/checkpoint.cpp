@@ -24,8 +24,10 @@ std::string checkpointSettingsText(const RenderSettings& s, int cameraIndex, con
     << "max-depth " << s.maxDepth << '\n'
     << "integrator " << integratorName(s.integrator) << '\n'
     << "dispersion " << dispersionModeName(s.dispersion) << '\n'
-    << "caster-probability " << s.casterProbability << '\n'
-    << "camera " << cameraIndex << '\n'
+    << "caster-probability " << s.casterProbability << '\n';
+  // Only other modes say theirs, so checkpoints written before modes existed still resume.
+  if (s.mode != RenderMode::Path) t << "mode " << renderModeName(s.mode) << '\n';
+  t << "camera " << cameraIndex << '\n'
     << "camera-view " << c.position.x << ' ' << c.position.y << ' ' << c.position.z << ' ' << c.forward.x << ' '
     << c.forward.y << ' ' << c.forward.z << ' ' << c.up.x << ' ' << c.up.y << ' ' << c.up.z << ' ' << c.yfov << ' '
     << c.aspect << '\n';

@@ -113,6 +113,9 @@ double Options::getDouble(const std::string& name, double fallback) const {
 std::vector<OptionSpec> sceneOptionSpecs() {
   std::vector<OptionSpec> specs = {
       {"--size", "", "W[xH]", "image size in pixels (default 512; H follows the camera's aspect)"},
+      {"--mode", "", "MODE",
+       "path (the path tracer; default), whitted (ray tracer: point lights, mirrors, glass, no GI) or raster "
+       "(OpenGL raster pipeline) (docs/render-modes.md)"},
       {"--seed", "", "S", "random seed (default 1); the same seed gives the same image"},
       {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
       {"--dispersion", "", "MODE", "rgb (one channel per path; default) or spectral (hero wavelength)"},
@@ -120,6 +123,9 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--caster-probability", "", "P",
        "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
+      {"--light-radius", "", "R",
+       "turn point and spot lights into emissive spheres of radius R (scene units), same power: bounces find "
+       "them, so their caustics appear (more noise)"},
       {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
       {"--quiet", "-q", "", "print nothing but errors"},
@@ -274,6 +280,14 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
   LoadedScene ls;
   ls.scene = loadScene(path, loadOptions);
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
+  if (opts.has("--light-radius")) {
+    const double r = opts.getDouble("--light-radius", 0.0);
+    if (!(r > 0.0) || r > 3.0e38) throw Error("option --light-radius needs a positive number of scene units");
+    const std::size_t before = ls.scene.punctualLights.size();
+    applyLightRadius(ls.scene, static_cast<float>(r));
+    note(!verbose, "--light-radius: " + std::to_string(before - ls.scene.punctualLights.size()) +
+                       " point/spot light(s) made emissive spheres of radius " + opts.get("--light-radius", ""));
+  }
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {
     if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");
@@ -301,6 +315,7 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
   if (!opts.isList("--integrator")) s.integrator = parseIntegrator(opts.get("--integrator", integratorName(defaults.integrator)));
   if (!opts.isList("--dispersion"))
     s.dispersion = parseDispersionMode(opts.get("--dispersion", dispersionModeName(defaults.dispersion)));
+  if (!opts.isList("--mode")) s.mode = parseRenderMode(opts.get("--mode", renderModeName(defaults.mode)));
   s.casterProbability = static_cast<float>(opts.getDouble("--caster-probability", defaults.casterProbability));
   if (!(s.casterProbability >= 0.0f && s.casterProbability <= kMaxCasterProbability)) {
     std::ostringstream m;

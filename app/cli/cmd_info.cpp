@@ -35,7 +35,7 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {{"--camera", "", "N", "describe the scene's N-th camera (default 0)"}};
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   Options opts("caustica info SCENE [--camera N] [options]",
-               "Prints triangles, emitters (count, total power), materials by kind, bounds, camera,\n"
+               "Prints triangles, emitters (count, total power), punctual lights, materials by kind, bounds, camera,\n"
                "BVH statistics and the shader features the scene needs. Needs no GPU.",
                specs);
   if (!opts.parse(args)) return 0;
@@ -52,6 +52,23 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("triangles:  %zu\n", s.triangles.size());
   std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitters.size(),
               g.totalPower);
+  // KHR_lights_punctual, with their share of the light choices (by power, punctual_lights.h).
+  std::printf("punctual:   %zu light(s)%s\n", s.punctualLights.size(),
+              s.punctualLights.empty() ? "" : " (point/spot: intensity in cd; directional: lux; chosen by power)");
+  double totalPunctual = 0.0;
+  for (const PunctualLight& l : s.punctualLights) totalPunctual += punctualPower(l, s.bounds);
+  for (const PunctualLight& l : s.punctualLights) {
+    std::string where = l.type == PunctualType::Directional ? "shining " + vec(l.direction) : "at " + vec(l.position);
+    if (l.type == PunctualType::Spot) {
+      char b[96];
+      std::snprintf(b, sizeof b, " towards %s, cone %.1f-%.1f deg", vec(l.direction).c_str(), l.innerCone * 57.29578f,
+                    l.outerCone * 57.29578f);
+      where += b;
+    }
+    const double share = totalPunctual > 0.0 ? punctualPower(l, s.bounds) / totalPunctual : 0.0;
+    std::printf("            %s '%s' %s, intensity %s, chosen %.3g of the time\n", punctualTypeName(l.type),
+                l.name.c_str(), where.c_str(), vec(l.intensity).c_str(), share);
+  }
   std::map<std::string, int> kinds;
   for (const auto& m : s.materials) kinds[materialKind(m)]++;
   std::printf("materials:  %zu\n", s.materials.size());

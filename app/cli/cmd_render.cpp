@@ -77,7 +77,8 @@ int cmdRender(const std::vector<std::string>& args) {
   LoadedScene ls = loadSceneForCli(opts, !quiet);
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
-  const std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
+  std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
+  if (opts.has("--light-radius")) settingsText += "light-radius " + opts.get("--light-radius", "") + "\n";  // changes the scene
   if (resumeFrom) {
     std::string diff = checkpointMismatch(*resumeFrom, sceneHash, settingsText);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
@@ -91,7 +92,7 @@ int cmdRender(const std::vector<std::string>& args) {
                   std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
                   renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
-                  integratorName(settings.integrator));
+                  (settings.mode == RenderMode::Path ? integratorName(settings.integrator) : renderModeName(settings.mode)));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);
     note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");

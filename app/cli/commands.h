@@ -10,5 +10,6 @@ int cmdRender(const std::vector<std::string>& args);
 int cmdInfo(const std::vector<std::string>& args);
 int cmdView(const std::vector<std::string>& args);
 int cmdBench(const std::vector<std::string>& args);
+int cmdCompare(const std::vector<std::string>& args);
 
 }  // namespace caustica::cli

@@ -12,6 +12,16 @@ void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
 void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
 void deleteProgram(GLuint id) { glDeleteProgram(id); }
 void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
+void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
+
+std::string shaderInfoLog(GLuint obj, bool isShader) {
+  GLint len = 0;
+  isShader ? glGetShaderiv(obj, GL_INFO_LOG_LENGTH, &len) : glGetProgramiv(obj, GL_INFO_LOG_LENGTH, &len);
+  std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
+  isShader ? glGetShaderInfoLog(obj, len, nullptr, log.data()) : glGetProgramInfoLog(obj, len, nullptr, log.data());
+  log.resize(std::min(log.size(), log.find('\0')));
+  return log;
+}
 
 std::string errorName(GLenum e) {
   switch (e) {
@@ -177,6 +187,157 @@ GlProgram GlProgram::compileCompute(const std::string& source,
   if (!ok) throw Error("shader " + name + " failed to link:\n" + mapLog(infoLog(prog, false)));
   return p;
 }
+
+GlProgram GlProgram::compileGraphics(const std::string& vertexSource,
+                                     const std::function<std::string(const std::string&)>& mapVertexLog,
+                                     const std::string& fragmentSource,
+                                     const std::function<std::string(const std::string&)>& mapFragmentLog,
+                                     const std::string& name) {
+  auto compile = [&](GLenum stage, const std::string& source, const std::function<std::string(const std::string&)>& mapLog,
+                     const char* stageName) {
+    GLuint shader = glCreateShader(stage);
+    const char* src = source.c_str();
+    glShaderSource(shader, 1, &src, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      std::string log = shaderInfoLog(shader, true);
+      glDeleteShader(shader);
+      throw Error("shader " + name + " (" + stageName + " stage) failed to compile:\n" + mapLog(log));
+    }
+    return shader;
+  };
+  GLuint vs = compile(GL_VERTEX_SHADER, vertexSource, mapVertexLog, "vertex");
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragmentSource, mapFragmentLog, "fragment");
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  GlProgram p;
+  GLuint prog = glCreateProgram();
+  p.handle_ = GlHandle(prog, deleteProgram);
+  glAttachShader(prog, vs);
+  glAttachShader(prog, fs);
+  glLinkProgram(prog);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+  if (!ok) throw Error("shader " + name + " failed to link:\n" + shaderInfoLog(prog, false));
+  return p;
+}
+
+GlTexture GlTexture::createSrgb8(int width, int height, const void* rgba8, GLenum wrapS, GLenum wrapT, bool nearest) {
+  GlTexture t;
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  t.handle_ = GlHandle(id, deleteTexture);
+  t.width_ = width;
+  t.height_ = height;
+  t.format_ = GL_SRGB8_ALPHA8;
+  int levels = 1;
+  while ((std::max(width, height) >> levels) > 0) ++levels;
+  glBindTexture(GL_TEXTURE_2D, id);
+  glTexStorage2D(GL_TEXTURE_2D, levels, GL_SRGB8_ALPHA8, width, height);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba8);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, static_cast<GLint>(wrapS));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, static_cast<GLint>(wrapT));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, nearest ? GL_NEAREST_MIPMAP_NEAREST : GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, nearest ? GL_NEAREST : GL_LINEAR);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("raster texture creation");
+  return t;
+}
+
+GlTexture GlTexture::createDepthStencil(int width, int height) {
+  GlTexture t;
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  t.handle_ = GlHandle(id, deleteTexture);
+  t.width_ = width;
+  t.height_ = height;
+  t.format_ = GL_DEPTH24_STENCIL8;
+  glBindTexture(GL_TEXTURE_2D, id);
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH24_STENCIL8, width, height);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("depth-stencil target creation");
+  return t;
+}
+
+GlTexture GlTexture::createDepthCubeArray(int size, int cubes) {
+  GlTexture t;
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  t.handle_ = GlHandle(id, deleteTexture);
+  t.width_ = size;
+  t.height_ = size;
+  t.format_ = GL_DEPTH_COMPONENT32F;
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, id);
+  glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_DEPTH_COMPONENT32F, size, size, 6 * std::max(cubes, 1));
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, 0);
+  checkGlError("shadow cube map creation");
+  return t;
+}
+
+GlVertexArray GlVertexArray::create(const GlBuffer& vertices, std::size_t strideBytes, const std::vector<Attribute>& attributes) {
+  GlVertexArray v;
+  GLuint id = 0;
+  glGenVertexArrays(1, &id);
+  v.handle_ = GlHandle(id, deleteVertexArray);
+  glBindVertexArray(id);
+  glBindBuffer(GL_ARRAY_BUFFER, vertices.id());
+  for (const Attribute& a : attributes) {
+    glEnableVertexAttribArray(a.location);
+    glVertexAttribPointer(a.location, a.components, GL_FLOAT, GL_FALSE, static_cast<GLsizei>(strideBytes),
+                          reinterpret_cast<const void*>(a.offset));
+  }
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  checkGlError("vertex array creation");
+  return v;
+}
+
+void GlVertexArray::bind() const { glBindVertexArray(id()); }
+
+GlFramebuffer GlFramebuffer::forTargets(const GlTexture& color, const GlTexture& depthStencil) {
+  GlFramebuffer f;
+  GLuint id = 0;
+  glGenFramebuffers(1, &id);
+  f.handle_ = GlHandle(id, deleteFramebuffer);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, id);
+  glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.id(), 0);
+  glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, depthStencil.id(), 0);
+  GLenum status = glCheckFramebufferStatus(GL_DRAW_FRAMEBUFFER);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("raster framebuffer incomplete (status " + std::to_string(status) + ")");
+  return f;
+}
+
+GlFramebuffer GlFramebuffer::forDepthLayer(const GlTexture& cubeArray, int layer) {
+  GlFramebuffer f;
+  GLuint id = 0;
+  glGenFramebuffers(1, &id);
+  f.handle_ = GlHandle(id, deleteFramebuffer);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, id);
+  glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, cubeArray.id(), 0, layer);
+  glDrawBuffer(GL_NONE);
+  GLenum status = glCheckFramebufferStatus(GL_DRAW_FRAMEBUFFER);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("shadow map framebuffer incomplete (status " + std::to_string(status) + ")");
+  return f;
+}
+
+void GlFramebuffer::bindDraw() const { glBindFramebuffer(GL_DRAW_FRAMEBUFFER, handle_.id()); }
 
 void GlProgram::use() const { glUseProgram(id()); }
 GLint GlProgram::uniformLocation(const char* n) const { return glGetUniformLocation(id(), n); }

@@ -74,6 +74,14 @@ class GlTexture {
   void uploadRgba32f(const std::vector<float>& rgba);
   // r32ui texture: writes `values` row by row from texel (0, 0), the last row padded with zeros.
   void uploadR32uiRows(const std::vector<std::uint32_t>& values);
+  // Raster mode: an sRGB RGBA8 colour texture with mipmaps (rgba8: width*height*4 bytes, row 0 =
+  // t 0), wrap GL_REPEAT / GL_MIRRORED_REPEAT / GL_CLAMP_TO_EDGE per axis, nearest or trilinear.
+  static GlTexture createSrgb8(int width, int height, const void* rgba8, GLenum wrapS, GLenum wrapT, bool nearest);
+  // Raster mode: a depth-stencil render target (GL_DEPTH24_STENCIL8).
+  static GlTexture createDepthStencil(int width, int height);
+  // Raster mode: `cubes` depth cube maps of `size`^2 texels per face (GL_TEXTURE_CUBE_MAP_ARRAY,
+  // GL_DEPTH_COMPONENT32F, linear filtering, no comparison); layer = cube * 6 + face.
+  static GlTexture createDepthCubeArray(int size, int cubes);
   int width() const { return width_; }
   int height() const { return height_; }
   GLuint id() const { return handle_.id(); }
@@ -84,10 +92,14 @@ class GlTexture {
   GLenum format_ = 0;
 };
 
-// A linked compute program.
+// A linked compute program (or, for the raster mode, a vertex + fragment program).
 class GlProgram {
  public:
   GlProgram() = default;
+  // Vertex and fragment stages; errors name `name` and the stage, with each log mapped by its mapLog.
+  static GlProgram compileGraphics(const std::string& vertexSource, const std::function<std::string(const std::string&)>& mapVertexLog,
+                                   const std::string& fragmentSource, const std::function<std::string(const std::string&)>& mapFragmentLog,
+                                   const std::string& name);
   // Compiles and links; on failure throws Error whose message is `mapLog(driver log)`.
   static GlProgram compileCompute(const std::string& source, const std::function<std::string(const std::string&)>& mapLog,
                                   const std::string& name);
@@ -99,11 +111,34 @@ class GlProgram {
   GlHandle handle_;
 };
 
-// A read framebuffer with one colour texture, used to blit the display image to a window.
+// A vertex array over one interleaved float vertex buffer (raster mode).
+class GlVertexArray {
+ public:
+  struct Attribute {
+    GLuint location;
+    GLint components;   // floats
+    std::size_t offset;  // bytes into a vertex
+  };
+  GlVertexArray() = default;
+  static GlVertexArray create(const GlBuffer& vertices, std::size_t strideBytes, const std::vector<Attribute>& attributes);
+  void bind() const;
+  GLuint id() const { return handle_.id(); }
+
+ private:
+  GlHandle handle_;
+};
+
+// A read framebuffer with one colour texture, used to blit the display image to a window; or (raster
+// mode) a draw framebuffer with a colour texture and a depth-stencil texture, or a depth layer only.
 class GlFramebuffer {
  public:
   GlFramebuffer() = default;
   static GlFramebuffer forTexture(const GlTexture& texture);
+  // Colour attachment 0 = `color` (may be 0-sized to leave it out), depth-stencil = `depthStencil`.
+  static GlFramebuffer forTargets(const GlTexture& color, const GlTexture& depthStencil);
+  // Depth only: layer `layer` of a depth cube-map array (no colour buffer).
+  static GlFramebuffer forDepthLayer(const GlTexture& cubeArray, int layer);
+  void bindDraw() const;  // as GL_DRAW_FRAMEBUFFER
   void blitToDefault(int srcW, int srcH, int dstW, int dstH) const;
 
  private:

@@ -19,6 +19,17 @@ DispersionMode parseDispersionMode(const std::string& name) {
   throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
 }
 
+RenderMode parseRenderMode(const std::string& name) {
+  if (name == "path") return RenderMode::Path;
+  if (name == "whitted") return RenderMode::Whitted;
+  if (name == "raster") return RenderMode::Raster;
+  throw Error("unknown render mode '" + name + "' (expected path, whitted or raster)");
+}
+
+const char* renderModeName(RenderMode m) {
+  return m == RenderMode::Path ? "path" : m == RenderMode::Whitted ? "whitted" : "raster";
+}
+
 const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
 const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
 
@@ -37,7 +48,8 @@ void RenderSettings::validate() const {
 
 bool RenderSettings::operator==(const RenderSettings& o) const {
   return width == o.width && height == o.height && seed == o.seed && maxDepth == o.maxDepth &&
-         integrator == o.integrator && dispersion == o.dispersion && casterProbability == o.casterProbability;
+         integrator == o.integrator && dispersion == o.dispersion && casterProbability == o.casterProbability &&
+         mode == o.mode;
 }
 
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to) {
@@ -45,7 +57,7 @@ SettingsChange compareSettings(const RenderSettings& from, const RenderSettings&
   c.restart = from != to;
   c.resize = from.width != to.width || from.height != to.height;
   c.shader = from.integrator != to.integrator || from.dispersion != to.dispersion ||
-             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f);
+             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.mode != to.mode;
   c.casters = from.casterProbability != to.casterProbability;
   return c;
 }

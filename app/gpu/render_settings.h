@@ -8,6 +8,11 @@ namespace caustica {
 
 enum class Integrator { Naive, Mis };
 enum class DispersionMode { Rgb, Spectral };
+// How the image is made (docs/render-modes.md): the path tracer, a Whitted ray tracer (compute
+// shader, point lights, mirrors and glass, no global illumination) or the OpenGL raster pipeline.
+enum class RenderMode { Path, Whitted, Raster };
+RenderMode parseRenderMode(const std::string& name);          // "path" | "whitted" | "raster"; throws Error otherwise
+const char* renderModeName(RenderMode m);
 Integrator parseIntegrator(const std::string& name);          // "naive" | "mis"; throws Error otherwise
 DispersionMode parseDispersionMode(const std::string& name);  // "rgb" | "spectral"; throws Error otherwise
 const char* integratorName(Integrator i);
@@ -30,6 +35,7 @@ struct RenderSettings {
   // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
   // instead of cosine sampling; 0 turns it off; at most kMaxCasterProbability.
   float casterProbability = 0.5f;
+  RenderMode mode = RenderMode::Path;
 
   // Throws Error naming the first setting out of range.
   void validate() const;
@@ -42,7 +48,7 @@ struct RenderSettings {
 struct SettingsChange {
   bool restart = false;  // anything differs: the accumulated samples no longer belong to the image
   bool resize = false;   // width or height: new accumulation images
-  bool shader = false;   // integrator, dispersion mode or caster aiming on/off: maybe another variant
+  bool shader = false;   // integrator, dispersion mode, caster aiming on/off or render mode: maybe another variant
   bool casters = false;  // caster probability: the caster UBO
 };
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to);

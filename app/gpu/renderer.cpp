@@ -7,9 +7,31 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "gpu/raster_renderer.h"
 #include "util/error.h"
 
 namespace caustica {
+
+gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const Bounds& bounds) {
+  gpu::PointLights pl{};
+  pl.count.x = static_cast<std::uint32_t>(std::min<size_t>(groups.size(), CAUSTICA_MAX_POINT_LIGHTS));
+  for (std::uint32_t i = 0; i < pl.count.x; ++i) {
+    const LightGroup& g = groups[i];
+    float far = 0.0f;
+    if (!bounds.empty())
+      for (int c = 0; c < 8; ++c) {
+        glm::vec3 corner((c & 1) ? bounds.max.x : bounds.min.x, (c & 2) ? bounds.max.y : bounds.min.y,
+                         (c & 4) ? bounds.max.z : bounds.min.z);
+        far = std::max(far, glm::length(corner - g.position));
+      }
+    pl.light[i].position = glm::vec4(g.position, g.isotropic);
+    pl.light[i].intensity = glm::vec4(g.intensity, std::max(far * 1.01f, 1e-6f));
+    pl.light[i].axis = glm::vec4(g.axis, 0.0f);
+  }
+  return pl;
+}
+
+Renderer::~Renderer() = default;
 
 Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
     : library_(library), settings_(settings), camera_(camera) {
@@ -45,13 +67,31 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
+  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
   uploadCasters();
+  lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
+  Bounds sceneBounds;
+  if (!g.nodes.empty() && g.nodes[0].bmin.x <= g.nodes[0].bmax.x) {
+    sceneBounds.grow(g.nodes[0].bmin);
+    sceneBounds.grow(g.nodes[0].bmax);
+  }
+  pointLights_ = pointLightParams(lightGroups_, sceneBounds);
+  pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
   allocateImages();
-  program();  // compile now, so shader errors surface before rendering starts
+  prepareMode();  // compile now, so shader errors surface before rendering starts
+}
+
+void Renderer::prepareMode() {
+  if (settings_.mode != RenderMode::Raster) {
+    program();
+  } else if (!raster_) {
+    raster_ = std::make_unique<RasterRenderer>(library_, gpuScene_, pointLights_);
+  }
 }
 
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
+  if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
@@ -62,13 +102,13 @@ std::vector<std::string> Renderer::shaderDefines() const {
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
-  std::string key;
+  const char* entry = settings_.mode == RenderMode::Whitted ? "whitted.comp" : "pathtrace.comp";
+  std::string key = std::string(entry) + ":";
   for (const auto& d : defines) key += d + " ";
   auto it = programs_.find(key);
   if (it != programs_.end()) return it->second;
-  ExpandedShader src = library_.expand("pathtrace.comp", defines);
-  GlProgram p = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
-                                          "pathtrace.comp");
+  ExpandedShader src = library_.expand(entry, defines);
+  GlProgram p = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); }, entry);
   return programs_.emplace(key, std::move(p)).first->second;
 }
 
@@ -85,7 +125,7 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   const RenderSettings previous = settings_;
   settings_ = settings;
   try {
-    if (change.shader) program();  // compile now: errors surface here, and callers may warm it up
+    if (change.shader) prepareMode();  // compile now: errors surface here, and callers may warm it up
   } catch (...) {
     settings_ = previous;
     throw;
@@ -144,11 +184,22 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   y0 = std::max(0, y0);
   y1 = std::min(settings_.height, y1);
   if (y1 <= y0 || spp <= 0) return;
+  if (settings_.mode == RenderMode::Raster) {
+    // One deterministic frame drawn straight into the accumulation image (alpha = 1 sample), once
+    // per restart: later passes would only draw the same frame again.
+    if (spp_ == 0 && y0 == 0) {
+      prepareMode();
+      pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
+      raster_->draw(camera_, accum_);
+      glFinish();
+    }
+    return;
+  }
   dispatchSamples(spp, y0, y1, false);
 }
 
 void Renderer::renderPass(int spp) {
-  if (tileListActive_) {
+  if (tileListActive_ && settings_.mode != RenderMode::Raster) {  // raster: one frame, no samples to spread
     if (liveTiles_ > 0 && spp > 0) dispatchSamples(spp, 0, settings_.height, true);
   } else {
     renderRows(0, settings_.height, spp);
@@ -201,6 +252,8 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
   frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
+  pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
+  punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);

@@ -17,8 +17,15 @@
 #include "gpu/shader_library.h"
 #include "image/error_estimate.h"
 #include "image/tonemap.h"
+#include "scene/light_groups.h"
 
 namespace caustica {
+
+class RasterRenderer;
+
+// The PointLights UBO of the raster and Whitted modes for `groups` (at most CAUSTICA_MAX_POINT_LIGHTS),
+// with each light's shadow far distance reaching the farthest corner of `bounds`.
+gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const Bounds& bounds);
 
 // Totals over everything rendered since the last reset.
 struct RenderStats {
@@ -40,6 +47,7 @@ class Renderer {
  public:
   // Needs a current GL 4.3 context. Throws Error if the scene exceeds the GL limits.
   Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings);
+  ~Renderer();
 
   void setCamera(const Camera& camera);          // restarts accumulation
   // The one place that decides what a settings change needs: new images, another shader variant,
@@ -80,9 +88,12 @@ class Renderer {
   const Bvh& bvh() const { return bvh_; }
   double bvhBuildSeconds() const { return bvhSeconds_; }
   std::vector<std::string> shaderDefines() const;  // the variant the current settings need
+  // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
+  const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
 
  private:
   const GlProgram& program();
+  void prepareMode();  // compiles the current mode's compute variant, or builds the raster pipeline
   void allocateImages();
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
@@ -98,6 +109,11 @@ class Renderer {
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
+  std::vector<LightGroup> lightGroups_;
+  gpu::PointLights pointLights_{};
+  GlBuffer pointLightUbo_;
+  std::unique_ptr<RasterRenderer> raster_;  // built the first time the raster mode is used
+  GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
   GlTexture accum_, comp_, half_, tileList_, display_;
   std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_
   bool tileListActive_ = false;

@@ -148,6 +148,9 @@ class SceneBuilder {
   // accessors' min/max (node origins where those are missing); else 0.
   glm::dvec3 chooseOrigin() const;
   void addCamera(int index, const glm::dmat4& world, const tinygltf::Node& node, const std::string& at);
+  // KHR_lights_punctual (gltf_lights.cpp): the light a node places, if any (-1 = none), and its instance.
+  int nodeLight(const tinygltf::Node& node) const;
+  void addLight(int index, const glm::dmat4& world, const std::string& at);
 
   // ---- accessors (gltf_accessors.cpp) ----
   struct ViewBytes {
@@ -193,6 +196,8 @@ class SceneBuilder {
   };
   std::vector<CameraInstance> cameraInstances_;
   std::vector<MeshInstance> meshInstances_;
+  std::vector<CameraInstance> lightInstances_;  // same fields: `camera` holds the light index
+  bool warnedRange_ = false;
   glm::dvec3 origin_{0.0};  // subtracted from every world position before it becomes float
 };
 

@@ -20,7 +20,7 @@ using Json = nlohmann::json;
 
 const char* const kSupportedExtensions[] = {
     "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
-    "KHR_materials_dispersion", "KHR_materials_emissive_strength"};
+    "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_lights_punctual"};
 
 std::string supportedExtensionList() {
   std::string out;
@@ -68,7 +68,8 @@ class JsonChecker {
       forEach(root, key, [](const Json&, const std::string&) {});
     index(root, "", "scene");
     forEach(root, "scenes", [&](const Json& o, const std::string& at) { indexArray(o, at, "nodes"); });
-    forEach(root, "nodes", [&](const Json& o, const std::string& at) { checkNode(o, at); });
+    checkPunctualLights(root);  // before the nodes, which refer to its lights
+    forEach(root, "nodes", [&](const Json& o, const std::string& at) { checkNode(root, o, at); });
     forEach(root, "meshes", [&](const Json& o, const std::string& at) { checkMesh(root, o, at); });
     forEach(root, "accessors", [&](const Json& o, const std::string& at) { checkAccessor(root, o, at); });
     // All declared byteLengths are added up before any buffer's file is looked at.
@@ -235,7 +236,61 @@ class JsonChecker {
     }
   }
 
-  void checkNode(const Json& o, const std::string& at) const {
+  // KHR_lights_punctual: the lights array (types, colours, intensities, cone angles; the spec's
+  // ranges), so a bad light fails with the property it is about instead of rendering wrong.
+  void checkPunctualLights(const Json& root) const {
+    const Json* ext = find(root, "extensions");
+    if (!ext || !ext->is_object()) return;
+    const Json* lp = object(*ext, "extensions", "KHR_lights_punctual");
+    if (!lp) return;
+    const std::string lat = "extensions.KHR_lights_punctual";
+    const Json* lights = array(*lp, lat, "lights");
+    if (!lights) return;
+    for (std::size_t i = 0; i < lights->size(); ++i) {
+      const Json& l = (*lights)[i];
+      const std::string at = join(lat, "lights") + "[" + str(i) + "]";
+      expect(l.is_object(), l, at, "an object");
+      string(l, at, "name");
+      const std::string type = string(l, at, "type", true)->get<std::string>();
+      if (type != "point" && type != "spot" && type != "directional")
+        fail(join(at, "type") + " is \"" + oneLine(type) + "\"; it must be point, spot or directional");
+      numbers(l, at, "color", 3);
+      if (const Json* c = find(l, "color"))
+        for (std::size_t k = 0; k < 3; ++k)
+          if ((*c)[k].get<double>() < 0.0)
+            fail(join(at, "color") + "[" + str(k) + "] is " + num((*c)[k].get<double>()) + "; colours must not be negative");
+      if (const Json* v = number(l, at, "intensity"))
+        if (v->get<double>() < 0.0)
+          fail(join(at, "intensity") + " is " + num(v->get<double>()) + "; it must not be negative");
+      if (const Json* v = number(l, at, "range"))
+        if (!(v->get<double>() > 0.0)) fail(join(at, "range") + " is " + num(v->get<double>()) + "; it must be positive");
+      const Json* spot = object(l, at, "spot", type == "spot");
+      if (spot && type == "spot") {
+        const std::string sat = join(at, "spot");
+        const Json* in = number(*spot, sat, "innerConeAngle");
+        const Json* out = number(*spot, sat, "outerConeAngle");
+        const double inner = in ? in->get<double>() : 0.0, outer = out ? out->get<double>() : kPiD / 4.0;
+        if (!(inner >= 0.0 && inner < outer && outer <= kPiD / 2.0))
+          fail(sat + " has innerConeAngle " + num(inner) + " and outerConeAngle " + num(outer) +
+               " (radians); they must satisfy 0 <= inner < outer <= pi/2");
+      }
+    }
+  }
+
+  void checkNode(const Json& root, const Json& o, const std::string& at) const {
+    if (const Json* ext = object(o, at, "extensions"))
+      if (const Json* lp = object(*ext, join(at, "extensions"), "KHR_lights_punctual")) {
+        const std::string lat = join(at, "extensions.KHR_lights_punctual");
+        const Json* light = index(*lp, lat, "light", true);
+        const Json* rootExt = find(root, "extensions");
+        const Json* lights = rootExt && rootExt->is_object() && rootExt->contains("KHR_lights_punctual")
+                                 ? find((*rootExt)["KHR_lights_punctual"], "lights")
+                                 : nullptr;
+        const std::size_t count = lights ? lights->size() : 0;
+        if (light->get<std::uint64_t>() >= count)
+          fail(join(lat, "light") + " is " + str(light->get<std::uint64_t>()) + ", but the file has " + str(count) +
+               " lights (extensions.KHR_lights_punctual.lights)");
+      }
     index(o, at, "camera");
     index(o, at, "mesh");
     index(o, at, "skin");

@@ -29,6 +29,7 @@ void SceneBuilder::build() {
   scene_.origin = origin_;
   for (const CameraInstance& c : cameraInstances_) addCamera(c.camera, c.world, model_.nodes[std::size_t(c.node)], c.at);
   for (const MeshInstance& m : meshInstances_) addMesh(m.mesh, m.xf, m.at);
+  for (const CameraInstance& l : lightInstances_) addLight(l.camera, l.world, l.at);
   if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
   if (badNormals_ > 0)
     warn(str(badNormals_) + " triangle(s) had zero or non-finite vertex normals; flat normals used for them");
@@ -172,6 +173,7 @@ void SceneBuilder::traverse() {
       warnedSkin_ = true;
     }
     if (node.camera >= 0) cameraInstances_.push_back({node.camera, index, xf.world, at});
+    if (const int light = nodeLight(node); light >= 0) lightInstances_.push_back({light, index, xf.world, at});
     if (node.mesh >= 0) {
       const glm::dmat3 m3(xf.world);
       const double det = glm::determinant(m3);

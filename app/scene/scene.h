@@ -8,6 +8,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/punctual_lights.h"
+
 namespace caustica {
 
 // A base-colour or emissive texture, decoded to 8-bit RGBA (values as stored: sRGB-encoded colour).
@@ -82,12 +84,22 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<Camera> cameras;       // perspective cameras in the default scene's node-visit order (may be empty)
   std::vector<std::string> warnings; // things skipped or approximated, each naming the file
+  std::vector<PunctualLight> punctualLights;  // KHR_lights_punctual instances (punctual_lights.h)
+  std::vector<SpotEmitter> spotEmitters;      // materials of spot lights made spheres by --light-radius
   Bounds bounds;
   // World-space position (glTF units, double) of this scene's float origin: for a scene farther from
   // the world origin than its own size, the loader subtracts its centre from every position and
   // camera before converting to float, so it keeps full float precision; 0 for other scenes.
   glm::dvec3 origin{0.0};
 };
+
+// Whether anything in the scene emits light: an emissive material on a triangle or a punctual light.
+inline bool sceneHasLights(const Scene& s) {
+  if (!s.punctualLights.empty()) return true;
+  for (const Triangle& t : s.triangles)
+    if (t.material < s.materials.size() && s.materials[t.material].isEmissive()) return true;
+  return false;
+}
 
 // What loadScene accepts from a scene file it does not trust (docs/untrusted-input.md). Each limit
 // is checked before the memory it guards is spent; the defaults suit scenes up to a few GiB of GPU memory.

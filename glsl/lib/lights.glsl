@@ -8,6 +8,7 @@ struct LightSample {
   vec3 le;       // emitted radiance at p (towards the front; both ways if double-sided)
   float pdfArea; // probability density per unit area (selection and position)
   bool twoSided;
+  uint material;  // the emitter's material index
 };
 
 // Selection probability per unit area of emitter triangle material m: power weight / total, divided
@@ -31,7 +32,8 @@ bool sampleLight(float uSlot, float uAlias, vec2 uTri, out LightSample ls) {
   float len = length(c);
   if (!(len > 0.0)) return false;
   ls.n = c / len;
-  Material m = materials[floatBitsToUint(g.v0.w)];
+  ls.material = floatBitsToUint(g.v0.w);
+  Material m = materials[ls.material];
   vec2 uv = vec2(0.0);
 #ifdef CAUSTICA_TEXTURES
   TriShade s = triShade[tri];

@@ -30,6 +30,10 @@ using uint = std::uint32_t;
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
 #define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
+#define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
+#define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
+#define CAUSTICA_BINDING_PUNCTUAL 4   // UBO: PunctualParams (KHR_lights_punctual; a UBO, not a ninth SSBO)
+#define CAUSTICA_MAX_PUNCTUAL 128     // punctual lights a scene may have (PunctualParams.light[], 8 KiB)
 #define CAUSTICA_IMAGE_ACCUM 0        // image unit: rgba32f running sum of radiance
 #define CAUSTICA_IMAGE_COMP 1         // image unit: rgba32f Kahan compensation of the sum
 #define CAUSTICA_IMAGE_DISPLAY 2      // image unit: rgba8 tone-mapped display image
@@ -46,6 +50,14 @@ CAUSTICA_CONST uint kInvalidIndex = 0xffffffffu;
 CAUSTICA_CONST uint kMatDoubleSided = 1u;
 CAUSTICA_CONST uint kMatHasVolume = 2u;      // Beer–Lambert absorption inside (KHR_materials_volume)
 CAUSTICA_CONST uint kMatDispersive = 4u;     // KHR_materials_dispersion with dispersion > 0
+// A --light-radius sphere made from a spot light: emission is weighted by spotFalloff of the direction
+// it leaves in; absorption.xyz holds the spot axis, absorption.w cos(outer cone), emission.w cos(inner).
+CAUSTICA_CONST uint kMatSpotEmitter = 256u;
+
+// PunctualLight.position.w: the light's type
+CAUSTICA_CONST uint kPunctualPoint = 0u;
+CAUSTICA_CONST uint kPunctualSpot = 1u;
+CAUSTICA_CONST uint kPunctualDirectional = 2u;
 
 // ---- SSBO structs ----------------------------------------------------------------------------
 // 32-byte BVH node: bounds and either two children (left, left+1) or a range of triangles.
@@ -130,7 +142,39 @@ struct CasterParams {
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
 };
 
+// The raster and Whitted modes light the scene with point lights: the emissive triangles grouped
+// into at most CAUSTICA_MAX_POINT_LIGHTS lights at their power-weighted centres (app/scene/light_groups.h).
+// Radiant intensity towards unit direction w (from the light): intensity.rgb * (max(0, dot(axis.xyz, w)) + position.w),
+// so a flat one-sided emitter keeps its cosine lobe and a closed one shines evenly (std140).
+struct PointLight {
+  vec4 position;   // xyz: world-space position; w: isotropic part of the lobe (0 flat .. 1/4 closed)
+  vec4 intensity;  // rgb: sum of emitted radiance * area (* 2 if double-sided); w: shadow far distance (scene units)
+  vec4 axis;       // xyz: mean emitter normal, length = the flat part of the lobe (0..1); w: unused
+};
+struct PointLights {
+  uvec4 count;                                  // x: lights in use (0..CAUSTICA_MAX_POINT_LIGHTS); yzw unused
+  PointLight light[CAUSTICA_MAX_POINT_LIGHTS];
+};
+
+// One KHR_lights_punctual light (std140, 64 bytes); units in app/scene/punctual_lights.h.
+struct PunctualLight {
+  vec4 position;   // xyz: world-space position (point, spot); w: type (kPunctual*, as a float)
+  vec4 direction;  // xyz: unit world-space direction the light shines toward (spot, directional); w: cos(outer cone)
+  vec4 intensity;  // rgb: colour x intensity (cd as radiance x area; directional: lux as irradiance); w: cos(inner cone)
+  vec4 select;     // x: probability of choosing this light (power / total); y: cumulative probability up to and including it; zw unused
+};
+
+// Every punctual light of the scene, chosen by power at each non-delta vertex (std140).
+struct PunctualParams {
+  uvec4 count;                                   // x: lights in use (0..CAUSTICA_MAX_PUNCTUAL); yzw unused
+  PunctualLight light[CAUSTICA_MAX_PUNCTUAL];
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(PointLight) == 48, "PointLight must be 48 bytes (std140)");
+static_assert(sizeof(PointLights) == 16 + 48 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
+static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");
+static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");

@@ -8,6 +8,7 @@
 #include "../lib/spectral.glsl"
 #include "../lib/materials.glsl"
 #include "../lib/casters.glsl"
+#include "../lib/punctual.glsl"  // without CAUSTICA_PUNCTUAL: spotFalloff only (no UBO)
 
 layout(local_size_x = 64) in;
 
@@ -45,6 +46,7 @@ const uint kPrepareCasters = 18u;
 const uint kDiffuseDirectionPdf = 19u;
 const uint kSampleDiffuseDirection = 20u;
 const uint kHitPointError = 21u;
+const uint kSpotFalloff = 22u;
 
 uvec4 bits(vec4 v) { return floatBitsToUint(v); }
 uvec4 bits(vec3 v, float w) { return floatBitsToUint(vec4(v, w)); }
@@ -96,6 +98,8 @@ void main() {
     o[0] = bits(offsetRayOrigin(a[0].xyz, a[2].xyz, a[1].xyz), 0.0);
   } else if (function == kHitPointError) {  // a[0].xyz = (b0, b1, b2), a[1..3].xyz = p0, p1, p2
     o[0] = bits(hitPointError(a[0].x, a[0].y, a[0].z, a[1].xyz, a[2].xyz, a[3].xyz), 0.0);
+  } else if (function == kSpotFalloff) {  // a[0].xyz = (cos theta, cos outer, cos inner)
+    o[0].x = floatBitsToUint(spotFalloff(a[0].x, a[0].y, a[0].z));
   } else if (function == kSampleDielectric) {  // a[0] = (d, eta), a[1] = (n, u)
     vec3 wi;
     bool transmitted;

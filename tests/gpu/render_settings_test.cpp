@@ -83,3 +83,20 @@ TEST_CASE("render settings: names round-trip and unknown names are refused") {
   CHECK_THROWS_AS(parseIntegrator("bdpt"), Error);
   CHECK_THROWS_AS(parseDispersionMode("cmy"), Error);
 }
+
+TEST_CASE("render settings: the render mode parses, and a switch restarts with another shader") {
+  CHECK(parseRenderMode("path") == RenderMode::Path);
+  CHECK(parseRenderMode("whitted") == RenderMode::Whitted);
+  CHECK(parseRenderMode("raster") == RenderMode::Raster);
+  CHECK_THROWS_WITH_AS(parseRenderMode("Raster"), "unknown render mode 'Raster' (expected path, whitted or raster)", Error);
+  for (RenderMode m : {RenderMode::Path, RenderMode::Whitted, RenderMode::Raster}) CHECK(parseRenderMode(renderModeName(m)) == m);
+  RenderSettings a, b;
+  CHECK(a.mode == RenderMode::Path);
+  b.mode = RenderMode::Raster;
+  CHECK(a != b);
+  SettingsChange c = compareSettings(a, b);
+  CHECK(c.restart);
+  CHECK(c.shader);
+  CHECK_FALSE(c.resize);
+  CHECK_FALSE(c.casters);
+}

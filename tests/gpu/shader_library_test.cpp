@@ -101,11 +101,74 @@ TEST_CASE("every feature combination of pathtrace.comp compiles (glslang, GLSL 4
   }
 }
 
+TEST_CASE("the punctual-light variants compile on top of every integrator and material feature") {
+  // CAUSTICA_PUNCTUAL and CAUSTICA_SPOT_EMITTERS with each feature alone and with all of them (the
+  // full cross product with the features above would be 4x as many variants).
+  ShaderLibrary lib;
+  const auto& names = shaderFeatureNames();
+  std::vector<std::vector<std::string>> bases = {{}, names};
+  for (const auto& n : names) bases.push_back({n});
+  for (const auto& extra : std::vector<std::vector<std::string>>{
+           {"CAUSTICA_PUNCTUAL"}, {"CAUSTICA_SPOT_EMITTERS"}, {"CAUSTICA_PUNCTUAL", "CAUSTICA_SPOT_EMITTERS"}})
+    for (auto defines : bases) {
+      defines.insert(defines.end(), extra.begin(), extra.end());
+      std::string label;
+      for (const auto& d : defines) label += d + " ";
+      INFO("defines: ", label);
+      const std::string log = validate(lib.expand("pathtrace.comp", defines));
+      REQUIRE_MESSAGE(log.empty(), log);
+    }
+}
+
 TEST_CASE("the other entry shaders compile") {
   ShaderLibrary lib;
   for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/twins_test.comp"}) {
     std::string log = validate(lib.expand(entry, {}));
     INFO(entry);
+    CHECK_MESSAGE(log.empty(), log);
+  }
+}
+
+// Compiles and links a vertex + fragment pair (the raster mode's programs) with glslang.
+std::string validateGraphics(const ExpandedShader& vs, const ExpandedShader& fs) {
+  static bool initialised = glslang::InitializeProcess();
+  (void)initialised;
+  glslang::TShader v(EShLangVertex), f(EShLangFragment);
+  const char* vt = vs.source.c_str();
+  const char* ft = fs.source.c_str();
+  v.setStrings(&vt, 1);
+  f.setStrings(&ft, 1);
+  if (!v.parse(GetDefaultResources(), 430, ECoreProfile, false, false, EShMsgDefault)) return vs.mapLog(v.getInfoLog());
+  if (!f.parse(GetDefaultResources(), 430, ECoreProfile, false, false, EShMsgDefault)) return fs.mapLog(f.getInfoLog());
+  glslang::TProgram program;
+  program.addShader(&v);
+  program.addShader(&f);
+  if (!program.link(EShMsgDefault)) return program.getInfoLog();
+  return "";
+}
+
+TEST_CASE("render modes: every material feature combination of whitted.comp compiles (glslang, GLSL 4.30 core)") {
+  ShaderLibrary lib;
+  const std::vector<std::string> materialFeatures = {"CAUSTICA_MIRROR",    "CAUSTICA_GLASS",    "CAUSTICA_VOLUME",
+                                                     "CAUSTICA_DISPERSION", "CAUSTICA_TEXTURES", "CAUSTICA_OPACITY"};
+  for (unsigned mask = 0; mask < (1u << materialFeatures.size()); ++mask) {
+    std::vector<std::string> defines;
+    for (size_t i = 0; i < materialFeatures.size(); ++i)
+      if (mask & (1u << i)) defines.push_back(materialFeatures[i]);
+    std::string log = validate(lib.expand("whitted.comp", defines));
+    std::string label;
+    for (const auto& d : defines) label += d + " ";
+    INFO("defines: ", label);
+    REQUIRE_MESSAGE(log.empty(), log);
+  }
+}
+
+TEST_CASE("render modes: the raster programs (vertex + fragment stages) compile and link (glslang)") {
+  ShaderLibrary lib;
+  for (auto [vs, fs] : {std::pair<const char*, const char*>{"raster/raster.vert", "raster/raster.frag"},
+                        std::pair<const char*, const char*>{"raster/shadow.vert", "raster/shadow.frag"}}) {
+    std::string log = validateGraphics(lib.expand(vs, {}), lib.expand(fs, {}));
+    INFO(vs, " + ", fs);
     CHECK_MESSAGE(log.empty(), log);
   }
 }

@@ -19,6 +19,7 @@
 #include "gpu/shader_library.h"
 #include "accel/spawn.h"
 #include "shading/sampling.h"
+#include "scene/punctual_lights.h"
 
 using namespace caustica;
 
@@ -29,7 +30,7 @@ enum class Fn : GLuint {
   Pcg4d, RngSeed, Rand01, Luminance, OrthonormalBasis, SampleCosineHemisphere, SampleTriangleUniform,
   PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
   ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
-  DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError
+  DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError, SpotFalloff
 };
 
 constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
@@ -530,6 +531,22 @@ TEST_CASE("GLSL spectral functions equal their C++ twins: cauchyIor, channelSens
                 [&] { return str(lambdas[i]) + ": " + str(g) + " vs " + str(c); });
   }
   dSens.check();
+}
+
+TEST_CASE("GLSL spotFalloff equals its C++ twin (KHR_lights_punctual cone falloff)") {
+  GlslTwins gpu;
+  Random r(7);
+  std::vector<In> in;
+  // The cone edges themselves, a hard edge (inner == outer) and random cones and angles.
+  for (float c : {1.0f, std::cos(0.2f), std::cos(0.6f), 0.0f, -1.0f}) in.push_back(floats({c, std::cos(0.6f), std::cos(0.2f), 0}));
+  in.push_back(floats({std::cos(0.29f), std::cos(0.3f), std::cos(0.3f), 0}));
+  while (in.size() < 4096) {
+    const float outer = r.uniform(0.01f, 1.5707963f), inner = r.uniform(0.0f, outer);
+    in.push_back(floats({r.uniform(-1.0f, 1.0f), std::cos(outer), std::cos(inner), 0}));
+  }
+  // A subtraction, a division, a clamp and a square, values in [0, 1]: measured 0; a few ULP allowed.
+  compareOutput(gpu, Fn::SpotFalloff, in, MaxDiff("spotFalloff", 4 * kEps), Measure::Absolute,
+                [](const In& x) { return spotFalloff(arg(x, 0).x, arg(x, 0).y, arg(x, 0).z); });
 }
 
 TEST_CASE("GLSL caster functions equal their C++ twins: inCone, casterCone, sampleUniformCone, casterFacesLights") {

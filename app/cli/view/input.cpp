@@ -25,6 +25,7 @@ const char* const kViewerControls =
     "  W A S D, Q E         move forward, left, back, right, down, up (shift: faster, ctrl: slower)\n"
     "  F                    toggle fly mode (left drag looks around instead of orbiting)\n"
     "  R                    reset to the scene camera\n"
+    "  M                    render mode: path -> whitted -> raster (docs/render-modes.md)\n"
     "  I                    integrator: mis / naive\n"
     "  C                    mis: caster aiming (bounces aimed at glass and mirrors) on / off\n"
     "  L                    dispersion: rgb / spectral (hero wavelength)\n"
@@ -64,6 +65,12 @@ void applyKeys(GlfwWindow& window, CameraController& controller, ViewControls& c
       case GLFW_KEY_SPACE: c.paused = !c.paused; break;
       case GLFW_KEY_R: controller.reset(); break;
       case GLFW_KEY_F: c.fly = !c.fly; break;
+      case GLFW_KEY_M:
+        c.wanted.mode = c.wanted.mode == RenderMode::Path      ? RenderMode::Whitted
+                        : c.wanted.mode == RenderMode::Whitted ? RenderMode::Raster
+                                                               : RenderMode::Path;
+        std::cout << "caustica: render mode " << renderModeName(c.wanted.mode) << "\n" << std::flush;
+        break;
       case GLFW_KEY_I:
         c.wanted.integrator = c.wanted.integrator == Integrator::Mis ? Integrator::Naive : Integrator::Mis;
         break;

@@ -1,5 +1,5 @@
 // input.h — the viewer's keys and mouse: camera motion for the CameraController, and the toggles
-// (integrator, casters, dispersion, depth, exposure, tone curve, pause, fly, screenshot) they set.
+// (render mode, integrator, casters, dispersion, depth, exposure, tone curve, pause, fly, screenshot) they set.
 #pragma once
 #include "gpu/render_settings.h"
 #include "image/tonemap.h"

@@ -3,12 +3,16 @@
 # images: the renderer seeds each sample by (pixel, sample index, seed), so they must agree to float
 # rounding however the viewer split its passes. A render with another seed must NOT match (the check
 # can fail). Run with cmake -P; XVFB_RUN, CLI, COMPARE, DIR, SIZE and VIEW_ARGS
-# (more viewer options) given.
+# (more viewer options) given; MODE (optional) is the --mode of both (docs/render-modes.md).
 file(REMOVE_RECURSE ${DIR})
 file(MAKE_DIRECTORY ${DIR})
 separate_arguments(viewArgs UNIX_COMMAND "${VIEW_ARGS}")
+set(modeArgs "")
+if(MODE)
+  set(modeArgs --mode ${MODE})
+endif()
 execute_process(COMMAND ${XVFB_RUN} -a -s "-screen 0 1280x1024x24"
-                        ${CLI} view cornell-glass --size ${SIZE} ${viewArgs} --seed 3 --frames 8 --screenshot ${DIR}/view.exr
+                        ${CLI} view cornell-glass --size ${SIZE} ${viewArgs} ${modeArgs} --seed 3 --frames 8 --screenshot ${DIR}/view.exr
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "view failed (${rc}): ${out}${err}")
@@ -22,7 +26,7 @@ if(spp LESS 1)
   message(FATAL_ERROR "the screenshot has no samples")
 endif()
 foreach(seed 3 4)
-  execute_process(COMMAND ${CLI} render cornell-glass --size ${SIZE} --seed ${seed} --spp ${spp} -o ${DIR}/render${seed}.exr -q
+  execute_process(COMMAND ${CLI} render cornell-glass --size ${SIZE} ${modeArgs} --seed ${seed} --spp ${spp} -o ${DIR}/render${seed}.exr -q
                   RESULT_VARIABLE rc ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "render failed (${rc}): ${err}")

@@ -15,14 +15,16 @@ if(CAUSTICA_VIEWER)
     # RESOURCE_LOCK: concurrent `xvfb-run -a` calls can race for the same server number.
     # The window's screenshot after some frames equals `render` with the same seed and spp: once with
     # the default budget, once with a tiny budget (passes split in row bands, a preview first).
-    foreach(case "default;64;" "banded;96x72;--budget-ms 2")
+    # The Whitted mode too (its jittered samples are seeded alike; docs/render-modes.md).
+    foreach(case "default;64;;" "banded;96x72;--budget-ms 2;" "whitted;64;;whitted")
       list(GET case 0 name)
       list(GET case 1 size)
       list(GET case 2 viewArgs)
+      list(GET case 3 mode)
       add_test(NAME "viewer: screenshot matches a headless render (${name})"
                COMMAND ${CMAKE_COMMAND} -DXVFB_RUN=${XVFB_RUN} -DCLI=$<TARGET_FILE:caustica>
                        -DCOMPARE=$<TARGET_FILE:viewer_image_compare> -DDIR=${VIEWER_TEST_DIR}/${name}
-                       -DSIZE=${size} "-DVIEW_ARGS=${viewArgs}" -P ${CMAKE_CURRENT_LIST_DIR}/view_matches_render.cmake)
+                       -DSIZE=${size} "-DVIEW_ARGS=${viewArgs}" "-DMODE=${mode}" -P ${CMAKE_CURRENT_LIST_DIR}/view_matches_render.cmake)
       set_tests_properties("viewer: screenshot matches a headless render (${name})"
                            PROPERTIES ENVIRONMENT "LP_NUM_THREADS=2" TIMEOUT 180 RESOURCE_LOCK xvfb)
     endforeach()
