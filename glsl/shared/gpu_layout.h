@@ -40,6 +40,9 @@ using uint = std::uint32_t;
 #define CAUSTICA_IMAGE_ACCUM 0        // image unit: rgba32f running sum of radiance
 #define CAUSTICA_IMAGE_COMP 1         // image unit: rgba32f Kahan compensation of the sum
 #define CAUSTICA_IMAGE_DISPLAY 2      // image unit: rgba8 tone-mapped display image
+#define CAUSTICA_IMAGE_HALF 3         // image unit: rgba32f sum (rgb) and count (a) of each pixel's odd-numbered samples (error estimate)
+#define CAUSTICA_IMAGE_TILES 4        // image unit: r32ui list of live tiles (adaptive sampling), x | y << 16 in tiles
+#define CAUSTICA_TILE_LIST_WIDTH 1024 // texels per row of the live-tile list image
 #define CAUSTICA_WORKGROUP_X 8        // compute work-group size in pixels
 #define CAUSTICA_WORKGROUP_Y 8
 #define CAUSTICA_BVH_STACK 64         // traversal stack entries; the builder guarantees depth < this
@@ -60,10 +63,6 @@ CAUSTICA_CONST uint kPunctualSpot = 1u;
 CAUSTICA_CONST uint kPunctualDirectional = 2u;
 CAUSTICA_CONST uint kMatAlphaTexture = 8u;   // alphaMode BLEND or MASK: the base-colour texture's alpha multiplies baseColor.a
 CAUSTICA_CONST uint kMatAlphaMask = 16u;     // alphaMode MASK with a texture: opaque where alpha >= cutoff (tex2.w), else absent
-
-// FrameParams.options.w flags
-CAUSTICA_CONST uint kFlagMis = 1u;           // next-event estimation + MIS (else pure BSDF sampling)
-CAUSTICA_CONST uint kFlagSpectral = 2u;      // hero-wavelength dispersion (else one RGB channel per path)
 
 // EnvironmentParams.size.z: what camera rays that leave the scene see
 CAUSTICA_CONST uint kBackgroundEnvironment = 0u;  // the environment (black if there is none)
@@ -140,9 +139,11 @@ struct FrameParams {
   vec4 camUp;       // xyz: up axis scaled by tan(yfov/2)
   vec4 camForward;  // xyz: unit viewing direction
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
-  uvec4 options;    // x: max depth, y: unused (one sample per dispatch), z: emitter count, w: kFlag* bits
+  uvec4 options;    // x: max depth, y: live tiles in the tile list (0: the dispatch covers `tile`; else one
+                    //    8x8 work group per listed tile, adaptive sampling), z: emitter count, w: unused (the integrator
+                    //    and dispersion mode are shader variants, not flags)
   uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
-  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); y: exposure (display); zw unused
+  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); yzw unused
 };
 
 // Caustic casters: bounding spheres of the scene's specular objects (glass, mirrors), aimed at from
