@@ -10,15 +10,21 @@
 #include "lib/camera.glsl"
 #include "lib/textures.glsl"
 #include "lib/spectral.glsl"
+#include "lib/microfacet.glsl"
 #include "lib/materials.glsl"
 #include "lib/lights.glsl"
+#ifdef CAUSTICA_ENV
+#include "lib/environment.glsl"
+#endif
 #if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
 #include "lib/punctual.glsl"
 #endif
 #ifdef CAUSTICA_CASTERS
 #include "lib/casters.glsl"
 #endif
+#include "lib/vertex.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/adaptive.glsl"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
 
@@ -27,24 +33,47 @@ shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samp
 uint gSecondaryRays = 0u;
 const uint kMaxPassThroughs = 256u;  // alpha pass-throughs a path may make beyond its bounces
 uint gShadowRays = 0u;
+#ifdef CAUSTICA_ENV
+#include "lib/environment_light.glsl"
+#endif
 
 #ifdef CAUSTICA_PUNCTUAL
-// The diffuse lobe's BSDF value times cos at wi (ns: shading normal on the path's side); a new lobe
-// evaluates its own here, so the light estimators below serve every non-delta vertex alike.
-vec3 diffuseBsdfCos(vec3 albedo, vec3 ns, vec3 wi) { return albedo * (INV_PI * max(dot(ns, wi), 0.0)); }
-
-// Punctual-light next-event estimate at a non-delta vertex (punctual.glsl): its own shadow ray,
-// no MIS (a delta light cannot be hit by a bounce). sigma: absorption of the medium the vertex is in.
-vec3 addPunctualLight(vec3 p, vec3 pError, vec3 ng, vec3 ns, vec3 albedo, vec3 sigma, float u) {
+// Punctual-light next-event estimate at a non-delta vertex v (punctual.glsl): its own shadow ray, no
+// MIS (a delta light cannot be hit by a bounce); the BSDF through vertexEval, like every light kind.
+vec3 addPunctualLight(Vertex v, float u) {
   vec3 wi, li;
   float dist;
-  if (!samplePunctualLight(p, pError, ng, u, wi, li, dist, gShadowRays)) return vec3(0.0);
+  if (!samplePunctualLight(v.p, v.pError, v.ng, u, wi, li, dist, gShadowRays)) return vec3(0.0);
 #ifdef CAUSTICA_VOLUME
+  vec3 sigma = dot(v.ng, wi) > 0.0 ? v.sigmaAbove : v.sigmaBelow;  // the medium the shadow ray runs in
   if (any(greaterThan(sigma, vec3(0.0)))) li *= exp(-sigma * dist);
 #endif
-  return diffuseBsdfCos(albedo, ns, wi) * li;
+  return vertexEval(v, wi) * li;
 }
 #endif
+
+// The index of refraction of a glass hit for the wavelength the path carries (nm; 0 = all). The first
+// dispersive event picks the path's wavelength (hero wavelength, or one RGB channel) and its filter.
+float glassIor(Material m, inout float lambda, inout vec3 filt, inout uvec4 rng) {
+  float ior = m.params.w;
+#ifdef CAUSTICA_DISPERSION
+  if ((m.tex.z & kMatDispersive) != 0u) {
+    if (lambda == 0.0) {  // the path keeps one wavelength from its first dispersive event on
+#ifdef CAUSTICA_SPECTRAL
+      lambda = kLambdaMin + (kLambdaMax - kLambdaMin) * rand01(rng);
+      filt = channelSensitivity(lambda) * (kLambdaMax - kLambdaMin);
+#else
+      int c = min(int(rand01(rng) * 3.0), 2);
+      lambda = kChannelLambda[c];
+      filt = vec3(0.0);
+      filt[c] = 3.0;
+#endif
+    }
+    ior = cauchyIor(ior, m.absorption.w, lambda);
+  }
+#endif
+  return ior;
+}
 
 // One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
 vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
@@ -55,7 +84,7 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   vec3 radiance = vec3(0.0);
   vec3 filt = vec3(1.0);   // per-channel weight of the wavelength(s) the path carries (dispersion)
   float lambda = 0.0;      // nm; 0 while the path still carries every wavelength
-  float prevPdf = 0.0;     // solid-angle pdf of the last BSDF sample (diffuse lobe)
+  float prevPdf = 0.0;     // solid-angle pdf of the last BSDF sample (non-delta lobes)
   bool prevDelta = true;   // last direction came from the camera or a delta lobe: no MIS on emitter hits
   vec3 prevP = vec3(0.0), prevN = vec3(0.0);  // last vertex's point and shading normal (light-tree pdf for MIS)
   vec3 sigma = vec3(0.0);  // absorption coefficient of the medium the ray travels in (per scene unit)
@@ -66,7 +95,12 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   for (uint depth = 0u; depth < maxDepth; ++depth) {
     if (depth + passThroughs > 0u) ++gSecondaryRays;
     Hit hit;
-    if (!traceClosest(org, dir, 3.0e38, hit)) break;
+    if (!traceClosest(org, dir, 3.0e38, hit)) {
+#ifdef CAUSTICA_ENV
+      radiance += beta * filt * escapedRadiance(dir, depth == 0u, prevDelta, prevPdf);  // environment_light.glsl
+#endif
+      break;
+    }
 #ifdef CAUSTICA_VOLUME
     beta *= exp(-sigma * hit.t);
 #endif
@@ -85,9 +119,13 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     float nsLen = length(nsRaw);
     vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
     if (dot(ns, ngFront) < 0.0) ns = -ns;
-    if (!front) ns = -ns;                   // shading normal on the side the ray came from
     vec2 uv = b0 * vec2(s.n0.w, s.vt.x) + hit.u * vec2(s.n1.w, s.vt.y) + hit.v * vec2(s.n2.w, s.vt.z);
     Material m = materials[floatBitsToUint(g.v0.w)];
+#ifdef CAUSTICA_TEXTURES
+    ns = applyNormalMap(m, ns, uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, vec2(s.n0.w, s.vt.x), vec2(s.n1.w, s.vt.y),
+                        vec2(s.n2.w, s.vt.z));
+#endif
+    if (!front) ns = -ns;                   // shading normal on the side the ray came from
 
     // Emission, weighted against light sampling when the last bounce could have sampled it.
     if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) {
@@ -98,7 +136,7 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_MIS
       if (!prevDelta) {
         float pdfLight = lightPdfArea(hit.tri, prevP, prevN) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
-        w = powerHeuristic(prevPdf, pdfLight);
+        w *= powerHeuristic(prevPdf, pdfLight);
       }
 #endif
       radiance += beta * filt * materialEmission(m, uv) * w;
@@ -118,7 +156,8 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #endif
 
     vec3 newDir;
-    uint lobe = chooseLobe(m, rand01(rng));
+    vec2 metalRough = materialMetalRough(m, uv);
+    uint lobe = chooseLobe(m, metalRough.x, metalRough.y, rand01(rng));
     if (lobe == kLobeDiffuse) {
 #ifdef CAUSTICA_CASTERS
       // Cosine sampling mixed with directions aimed at glass and mirror objects (casters.glsl): more
@@ -135,53 +174,29 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_MIS
       // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
       // traced (not at the last vertex the depth limit allows), so both estimators end alike.
-      LightSample ls;
-      if (depth + 1u < maxDepth && sampleLight(p, ns, rand01(rng), rand2(rng), ls)) {
-        vec3 toLight = ls.p - p;
-        float dist2 = dot(toLight, toLight);
-        float dist = sqrt(dist2);
-        vec3 wl = toLight / max(dist, 1.0e-30);
-        float cosLight = -dot(ls.n, wl);
-        float cosSurf = dot(ns, wl);
-        if ((cosLight > 0.0 || (ls.twoSided && cosLight < 0.0)) && cosSurf > 0.0 && dot(ng, wl) > 0.0 && dist > 0.0) {
-          vec3 nLight = cosLight > 0.0 ? ls.n : -ls.n;  // the emitter's geometric normal on p's side
-          cosLight = abs(cosLight);
-          float pdfLight = ls.pdfArea * dist2 / cosLight;
-          ++gShadowRays;
-          // The shadow ray joins two points each moved off its own surface past its error bound
-          // (spawn.glsl; pbrt-v4's SpawnRayTo): p along ng, the light point along its normal on p's
-          // side. The whole segment lies strictly on the lit side of the light's triangle, which
-          // therefore cannot occlude its own sample at any angle, distance or scale. (Reusing wl and
-          // dist from the unmoved p shifted the ray's end behind the emitter whenever ng and the
-          // light's normal point alike: curved lights came out dark, 3-10 %.)
-          vec3 from = offsetRayOrigin(p, pError, ng);
-          vec3 to = offsetRayOrigin(ls.p, ls.pError, nLight);
-          vec3 seg = to - from;
-          float segLen = length(seg);
-          if (segLen > 0.0 && !traceOccluded(from, seg / segLen, segLen * (1.0 - 1.0e-4))) {
-#ifdef CAUSTICA_CASTERS
-            float pdfBsdf = diffuseDirectionPdf(ns, wl);
-#else
-            float pdfBsdf = cosSurf * INV_PI;
-#endif
-            float w = powerHeuristic(pdfLight, pdfBsdf);
-            vec3 transmittance = vec3(1.0);
-#ifdef CAUSTICA_VOLUME
-            transmittance = exp(-sigma * dist);  // the shadow ray runs inside the same medium
-#endif
-#ifdef CAUSTICA_SPOT_EMITTERS
-            ls.le *= spotEmitterFactor(materials[ls.material], -wl);
-#endif
-            radiance += beta * filt * base.rgb * (INV_PI * cosSurf * w / pdfLight) * ls.le * transmittance;
-          }
-        }
+      if (depth + 1u < maxDepth) {
+        Bsdf lambert = makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0);
+        Vertex v = makeVertex(lambert, p, pError, ng, ns, dir, sigma, sigma);
+        radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
       }
+#ifdef CAUSTICA_ENV
+      // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
+      // Not inside an absorbing medium: the ray could only leave through its boundary.
+      vec2 uEnv = rand2(rng);
+      if (depth + 1u < maxDepth && sigma == vec3(0.0)) {
+        Vertex ve = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
+        radiance += beta * filt * addEnvironmentLight(ve, uEnv);
+      }
+#endif
 #endif
 #ifdef CAUSTICA_PUNCTUAL
       // Punctual lights: their own estimate, added to the emitters' (a sum of unbiased estimates);
       // in both integrators, since a bounce never finds a delta light.
       float uPunctual = rand01(rng);
-      if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(p, pError, ng, ns, base.rgb, sigma, uPunctual);
+      if (depth + 1u < maxDepth) {
+        Vertex vp = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
+        radiance += beta * filt * addPunctualLight(vp, uPunctual);
+      }
 #endif
 #ifdef CAUSTICA_CASTERS
       float cosOut = dot(newDir, ns);
@@ -209,25 +224,51 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
       prevDelta = true;
     }
 #endif
+#ifdef CAUSTICA_GGX
+    else if (lobe >= kLobeConductor) {  // GGX lobes: rough metal, plastic, rough glass (microfacet.glsl)
+      float eta = 1.0;
+      vec3 sigmaBelow = sigma;
 #ifdef CAUSTICA_GLASS
-    else {
-      float ior = m.params.w;
-#ifdef CAUSTICA_DISPERSION
-      if ((m.tex.z & kMatDispersive) != 0u) {
-        if (lambda == 0.0) {  // the path keeps one wavelength from its first dispersive event on
-#ifdef CAUSTICA_SPECTRAL
-          lambda = kLambdaMin + (kLambdaMax - kLambdaMin) * rand01(rng);
-          filt = channelSensitivity(lambda) * (kLambdaMax - kLambdaMin);
-#else
-          int c = min(int(rand01(rng) * 3.0), 2);
-          lambda = kChannelLambda[c];
-          filt = vec3(0.0);
-          filt[c] = 3.0;
+      if (lobe == kLobeRoughGlass) {
+        float ior = glassIor(m, lambda, filt, rng);
+        eta = front ? ior : 1.0 / ior;  // n beyond the surface / n on the ray's side
+#ifdef CAUSTICA_VOLUME
+        sigmaBelow = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
 #endif
-        }
-        ior = cauchyIor(ior, m.absorption.w, lambda);
       }
 #endif
+      Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, metalRough.y, eta), p, pError, ng, ns, dir, sigma, sigmaBelow);
+#ifdef CAUSTICA_MIS
+      if (depth + 1u < maxDepth) radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
+#endif
+#if defined(CAUSTICA_ENV) && defined(CAUSTICA_MIS)
+      // The environment's next-event estimate through this lobe (both sides for rough glass), matching
+      // the MIS weight escaped rays get after this vertex (environment_light.glsl).
+      vec2 uEnv = rand2(rng);
+      if (depth + 1u < maxDepth)
+        radiance += beta * filt * addEnvironmentLight(v, uEnv);
+#endif
+#ifdef CAUSTICA_PUNCTUAL
+      float uPunctual = rand01(rng);
+      if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(v, uPunctual);
+#endif
+      BsdfSample bs;
+      float uPart = rand01(rng);
+      if (!bsdfSample(v.bsdf, v.wo, vec3(uPart, rand2(rng)), bs)) break;
+      newDir = vertexToWorld(v, bs.wi);
+      if (bs.transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0) break;  // through the true surface: lost
+      beta *= bs.weight;
+      prevPdf = bs.pdf;
+      prevDelta = false;
+      if (bs.transmitted) {
+        etaScale *= eta * eta;
+        sigma = sigmaBelow;
+      }
+    }
+#endif
+#ifdef CAUSTICA_GLASS
+    else {
+      float ior = glassIor(m, lambda, filt, rng);
       float eta = front ? ior : 1.0 / ior;  // n_transmitted / n_incident
       bool transmitted;
       float u = rand01(rng);
@@ -262,9 +303,8 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 }
 
 void main() {
-  uvec2 local = gl_GlobalInvocationID.xy;
-  uvec2 pixel = local + frame.tile.xy;
-  bool valid = all(lessThan(local, frame.tile.zw)) && all(lessThan(pixel, frame.frame.xy));
+  uvec2 pixel;
+  bool valid = dispatchedPixel(pixel);  // adaptive.glsl: rows of frame.tile, or a live tile
   if (gl_LocalInvocationIndex == 0u) {
     groupCounts[0] = 0u;
     groupCounts[1] = 0u;

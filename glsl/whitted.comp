@@ -13,6 +13,7 @@
 #include "lib/materials.glsl"
 #include "lib/point_lights.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/adaptive.glsl"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
 
@@ -204,9 +205,8 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
 }
 
 void main() {
-  uvec2 local = gl_GlobalInvocationID.xy;
-  uvec2 pixel = local + frame.tile.xy;
-  bool valid = all(lessThan(local, frame.tile.zw)) && all(lessThan(pixel, frame.frame.xy));
+  uvec2 pixel;
+  bool valid = dispatchedPixel(pixel);  // adaptive.glsl: rows of frame.tile, or a live tile
   if (gl_LocalInvocationIndex == 0u) {
     groupCounts[0] = 0u;
     groupCounts[1] = 0u;

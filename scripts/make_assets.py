@@ -443,7 +443,9 @@ class Gltf:
 
     def material(self, name, color=(0.8, 0.8, 0.8), alpha=1.0, metallic=0.0, roughness=1.0,
                  emissive=None, strength=1.0, transmission=0.0, ior=None, thickness=None,
-                 dispersion=None, double_sided=False, base_texture=None):
+                 dispersion=None, double_sided=False, base_texture=None, specular=0.0):
+        """specular: KHR_materials_specular's specularFactor of the dielectric layer over the diffuse
+        base. The shipped Cornell scenes are Lambertian (0, written out); glTF's default is 1."""
         pbr = {"baseColorFactor": [clean(c) for c in color] + [clean(alpha)],
                "metallicFactor": clean(metallic), "roughnessFactor": clean(roughness)}
         if base_texture is not None:
@@ -464,6 +466,8 @@ class Gltf:
             ext["KHR_materials_volume"] = {"thicknessFactor": clean(thickness)}
         if dispersion is not None:
             ext["KHR_materials_dispersion"] = {"dispersion": clean(dispersion)}
+        if specular != 1.0 and metallic < 1.0 and transmission < 1.0:
+            ext["KHR_materials_specular"] = {"specularFactor": clean(specular)}
         if ext:
             mat["extensions"] = ext
             self.extensions.update(ext.keys())
@@ -577,6 +581,27 @@ def cornell_glass(segments=64, rings=32):
     mirror_mesh = g.mesh("mirror sphere", [dict(prim, material=mirror)])
     g.node("glass sphere", mesh=glass_mesh, translation=(-0.42, radius, 0.3))
     g.node("mirror sphere", mesh=mirror_mesh, translation=(0.42, radius, -0.35))
+    g.camera("camera", **CORNELL_CAMERA)
+    return g.finish()
+
+
+def cornell_materials(segments=48, rings=24):
+    """glTF metallic-roughness under two area lights: a rough gold metal sphere, a red plastic sphere
+    (GGX specular layer over a diffuse base, glTF's default specular) and a frosted glass sphere."""
+    g = Gltf()
+    add_cornell_box(g)
+    add_ceiling_light(g, 0.4, 0.3, x=-0.35)
+    add_ceiling_light(g, 0.4, 0.3, x=0.35)
+    radius = 0.3
+    gold = g.material("rough gold", color=(1.0, 0.766, 0.336), metallic=1.0, roughness=0.35)
+    plastic = g.material("red plastic", color=(0.6, 0.05, 0.04), roughness=0.25, specular=1.0)
+    frosted = g.material("frosted glass", color=(1.0, 1.0, 1.0), roughness=0.3, transmission=1.0, ior=1.5,
+                         thickness=2 * radius)
+    prim = g.primitive(uv_sphere(radius, segments, rings), gold)
+    for name, material, position in (("gold sphere", gold, (-0.5, radius, -0.3)),
+                                     ("plastic sphere", plastic, (0.5, radius, -0.2)),
+                                     ("frosted sphere", frosted, (0.0, radius, 0.35))):
+        g.node(name, mesh=g.mesh(name, [dict(prim, material=material)]), translation=position)
     g.camera("camera", **CORNELL_CAMERA)
     return g.finish()
 
@@ -808,6 +833,38 @@ def small_cornell():
     return cornell_glass(segments=16, rings=8)
 
 
+def quat_look(direction):
+    """Rotation (x, y, z, w) turning a camera's -Z towards `direction` with no roll: yaw about y after
+    pitch about x."""
+    dx, dy, dz = normalize(direction)
+    yaw = math.atan2(-dx, -dz)
+    pitch = math.atan2(dy, math.hypot(dx, dz))
+    sy, cy = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+    sx, cx = math.sin(pitch / 2.0), math.cos(pitch / 2.0)
+    return [clean(cy * sx), clean(sy * cx), clean(-sy * sx), clean(cy * cx)]
+
+
+def sun_glass():
+    """A glass ball and a clay box on a grey floor, open to the sky: no emitters; meant for an
+    environment (render with --env sun-sky: assets/env/sun-sky.hdr, written by scripts/make_sky_hdr.py;
+    its sun stands 35 degrees high, in front of the camera and to the left, so the ball's shadow and
+    caustic fall to its right, towards the camera)."""
+    g = Gltf()
+    floor = g.material("floor", color=(0.7, 0.7, 0.7))
+    clay = g.material("clay", color=(0.75, 0.35, 0.2))
+    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
+                       thickness=1.0)
+    mesh = MeshData()
+    mesh.polygon([(-6, 0, -6), (6, 0, -6), (6, 0, 6), (-6, 0, 6)], (0, 1, 0))
+    g.object("floor", mesh, floor)
+    g.object("glass ball", uv_sphere(0.5, 64, 32), glass, translation=(0.0, 0.5, 0.0))
+    g.object("clay box", unit_cube(), clay, translation=(1.2, 0.3, -1.0), rotation=quat_y(25.0),
+             scale_=(0.6, 0.6, 0.6))
+    eye, target = (0.3, 1.8, 3.9), (0.45, 0.2, 0.2)
+    g.camera("camera", position=eye, yfov=0.6, rotation=quat_look(sub(target, eye)))
+    return g.finish()
+
+
 # ---- bad inputs ------------------------------------------------------------------------------------
 def triangle_doc(positions=None, indices=(0, 1, 2), mode=None, extra_accessor_count=None):
     """A minimal valid one-triangle scene, returned as a dict to be broken by the caller."""
@@ -1012,8 +1069,10 @@ def main():
         os.path.join(SCENES, "cornell-bunny-light.gltf"): cornell_bunny_light(),
         os.path.join(SCENES, "cornell-textured.gltf"): cornell_textured(),
         os.path.join(SCENES, "cornell-dispersion.gltf"): cornell_dispersion(),
+        os.path.join(SCENES, "sun-glass.gltf"): sun_glass(),
         os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
         os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
+        os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),

@@ -2,9 +2,11 @@
 #include "accel/gpu_scene.h"
 
 #include <cmath>
+#include <cstring>
 
 #include "scene/caustic_casters.h"
 #include "util/error.h"
+#include "shading/microfacet.h"
 #include "shading/sampling.h"
 
 namespace caustica {
@@ -17,8 +19,10 @@ std::vector<std::string> SceneFeatures::defines() const {
   if (dispersion) d.push_back("CAUSTICA_DISPERSION");
   if (textures) d.push_back("CAUSTICA_TEXTURES");
   if (opacity) d.push_back("CAUSTICA_OPACITY");
+  if (environment) d.push_back("CAUSTICA_ENV");
   if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
   if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
+  if (ggx) d.push_back("CAUSTICA_GGX");
   return d;
 }
 
@@ -33,9 +37,19 @@ std::string SceneFeatures::describe() const {
   add(dispersion, "dispersion");
   add(textures, "textures");
   add(opacity, "opacity");
+  add(environment, "environment");
   add(punctual, "punctual");
   add(spotEmitters, "spot-emitters");
+  add(ggx, "ggx");
   return s.empty() ? "diffuse only" : s;
+}
+
+bool hasRoughLobe(const Material& m) {
+  const bool rough = m.roughness * m.roughness >= kDeltaAlpha || m.metallicRoughnessTexture >= 0;
+  const bool metal = m.metallic > 0.0f || m.metallicRoughnessTexture >= 0;
+  const bool glass = m.transmission > 0.0f && m.metallic < 1.0f;
+  const bool layered = m.metallic < 1.0f && m.transmission < 1.0f && m.specularF90 > 0.0f;
+  return (rough && (metal || glass)) || layered;
 }
 
 SceneFeatures sceneFeatures(const Scene& scene) {
@@ -52,9 +66,12 @@ SceneFeatures sceneFeatures(const Scene& scene) {
     f.volume |= glass && std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f &&
                 glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
     f.dispersion |= glass && m.dispersion > 0.0f;
-    f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
-    f.opacity |= m.baseColor.a < 1.0f;
+    f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0 || m.metallicRoughnessTexture >= 0 ||
+                  m.normalTexture >= 0;
+    f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture;
+    f.ggx |= hasRoughLobe(m);
   }
+  f.environment = scene.environment.emits() || scene.background.kind != Background::Kind::Environment;
   f.punctual = !scene.punctualLights.empty();
   for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
   return f;
@@ -93,11 +110,39 @@ std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, co
   return table;
 }
 
+namespace {
+std::uint32_t floatBits(float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+// The environment's texels, CDFs and UBO. An environment lights every point from everywhere, so
+// refractive casters are aimed at from every point: the sphere around the lights becomes one that
+// holds every point (its squared radius still finite in float).
+void packEnvironment(const Scene& scene, GpuScene& g) {
+  gpu::EnvironmentParams& p = g.environmentParams;
+  p.rotation = glm::vec4(1.0f, 0.0f, 0.0f, 0.0f);
+  if (scene.environment.emits()) {
+    g.environment = buildEnvironmentDistribution(scene.environment);
+    p.size = glm::uvec4(g.environment.width, g.environment.height, 0u, 0u);
+    p.rotation = glm::vec4(g.environment.cosRotation, g.environment.sinRotation, 0.0f, 0.0f);
+    g.emitterSphere = glm::vec4(0.5f * (scene.bounds.min + scene.bounds.max), 1.0e18f);
+  }
+  const Background& b = scene.background;
+  p.size.z = b.kind == Background::Kind::Color         ? gpu::kBackgroundColor
+             : b.kind == Background::Kind::Transparent ? gpu::kBackgroundTransparent
+                                                       : gpu::kBackgroundEnvironment;
+  p.background = glm::vec4(b.color, 0.0f);
+}
+}  // namespace
+
 GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   GpuScene g;
   g.features = sceneFeatures(scene);
   g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
   g.emitterSphere = emitterBoundingSphere(scene);
+  packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triGeom = packTriGeom(scene.triangles, bvh);
   g.triShade.resize(bvh.order.size());
@@ -127,6 +172,12 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
     gm.tex = glm::uvec4(m.baseColorTexture >= 0 ? static_cast<std::uint32_t>(m.baseColorTexture) : gpu::kInvalidIndex,
                         m.emissiveTexture >= 0 ? static_cast<std::uint32_t>(m.emissiveTexture) : gpu::kInvalidIndex,
                         flags, 0u);
+    const auto texIndex = [](int t) { return t >= 0 ? static_cast<std::uint32_t>(t) : gpu::kInvalidIndex; };
+    if (m.alphaFromTexture) gm.tex.z |= gpu::kMatAlphaTexture;
+    if (m.alphaFromTexture && m.alphaCutoff >= 0.0f) gm.tex.z |= gpu::kMatAlphaMask;
+    gm.specular = glm::vec4(m.specularF0, m.specularF90);
+    gm.tex2 = glm::uvec4(texIndex(m.metallicRoughnessTexture), texIndex(m.normalTexture),
+                         floatBits(m.normalScale), floatBits(m.alphaCutoff));
     g.materials.push_back(gm);
   }
   for (const SpotEmitter& e : scene.spotEmitters) {  // --light-radius spheres of spot lights
@@ -142,6 +193,12 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   for (const Texture& t : scene.textures) {
     gpu::TexInfo info{};
     info.offset = static_cast<std::uint32_t>(g.texels.size());
+    if (t.pixelSource >= 0) {  // a transformed reference: the texels of an earlier entry
+      if (std::size_t(t.pixelSource) >= g.texInfo.size()) throw Error("internal: texture pixel source out of order");
+      info.offset = g.texInfo[std::size_t(t.pixelSource)].offset;
+    }
+    info.uvRow0 = glm::vec4(t.uvRow0, 0.0f);
+    info.uvRow1 = glm::vec4(t.uvRow1, 0.0f);
     info.width = static_cast<std::uint32_t>(t.width);
     info.height = static_cast<std::uint32_t>(t.height);
     info.flags = (t.repeatS ? 1u : 0u) | (t.repeatT ? 2u : 0u) | (t.mirrorS ? 4u : 0u) | (t.mirrorT ? 8u : 0u) |

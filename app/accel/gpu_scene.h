@@ -9,18 +9,24 @@
 #include "accel/light_tree.h"
 #include "scene/caustic_casters.h"
 #include "scene/scene.h"
+#include "shading/environment_sampling.h"
 
 namespace caustica {
 
 // What the scene's materials need; each maps to one CAUSTICA_* shader define.
 struct SceneFeatures {
   bool mirror = false, glass = false, volume = false, dispersion = false, textures = false, opacity = false;
+  bool environment = false;  // an environment that emits, or a background other than it (CAUSTICA_ENV)
   bool punctual = false;      // KHR_lights_punctual lights: CAUSTICA_PUNCTUAL (their NEE, in both integrators)
   bool spotEmitters = false;  // --light-radius spheres of spot lights: CAUSTICA_SPOT_EMITTERS
+  bool ggx = false;  // a rough metal or glass, or a specular layer over a diffuse base (CAUSTICA_GGX)
   std::vector<std::string> defines() const;  // material defines only (not integrator or dispersion mode)
   std::string describe() const;              // e.g. "mirror glass dispersion" or "diffuse only"
 };
 SceneFeatures sceneFeatures(const Scene& scene);
+// True when the material has a GGX lobe: a metal or glass part with roughness^2 >= kDeltaAlpha (or a
+// metallicRoughness texture), or a diffuse part with a specular layer (specularF90 > 0).
+bool hasRoughLobe(const Material& m);
 
 struct GpuScene {
   std::vector<gpu::BvhNode> nodes;
@@ -37,6 +43,9 @@ struct GpuScene {
   glm::vec4 emitterSphere{0.0f, 0.0f, 0.0f, -1.0f};  // around every emitter (emitterBoundingSphere)
   gpu::PunctualParams punctual{};       // punctual lights and their selection probabilities (a UBO)
   SceneFeatures features;
+  // The environment map and its sampling CDFs (width 0: no environment light).
+  EnvironmentDistribution environment;
+  gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
 };
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh);

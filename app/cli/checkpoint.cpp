@@ -1,5 +1,5 @@
-// checkpoint.cpp — checkpoint file format: a text header after the magic line, then the two images'
-// raw floats (native little-endian), protected by an FNV-1a 64 checksum.
+// checkpoint.cpp — checkpoint file format: a text header after the magic line, then the three images'
+// raw floats (sums, Kahan compensation, odd-sample half) (native little-endian), protected by an FNV-1a 64 checksum.
 #include "cli/checkpoint.h"
 
 #include <cerrno>
@@ -38,7 +38,8 @@ namespace {
 
 std::uint64_t dataHash(const AccumulationState& st) {
   std::uint64_t h = fnv1a64(st.accum.data(), st.accum.size() * sizeof(float));
-  return fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
+  h = fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
+  return fnv1a64(st.half.data(), st.half.size() * sizeof(float), h);
 }
 
 std::map<std::string, std::string> parseLines(const std::string& text) {
@@ -57,7 +58,7 @@ std::map<std::string, std::string> parseLines(const std::string& text) {
 void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
   const AccumulationState& st = ck.state;
   const size_t n = static_cast<size_t>(st.width) * st.height * 4;
-  if (st.accum.size() != n || st.comp.size() != n) throw Error("internal: checkpoint images do not match its size");
+  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n) throw Error("internal: checkpoint images do not match its size");
   std::ostringstream h;
   h << kCheckpointMagic << ' ' << kCheckpointVersion << '\n'
     << "width " << st.width << '\n'
@@ -76,6 +77,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
     out.write(reinterpret_cast<const char*>(st.accum.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.comp.data()), static_cast<std::streamsize>(n * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(st.half.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.close();
     if (!out) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
   });
@@ -120,13 +122,15 @@ Checkpoint readCheckpoint(const std::string& path) {
   ck.settingsText = bytes.substr(settingsLineEnd + 1, settingsBytes);
   const size_t dataAt = end + 5;
   const size_t n = static_cast<size_t>(w) * hgt * 4;
-  if (bytes.size() != dataAt + 2 * n * sizeof(float))
+  if (bytes.size() != dataAt + 3 * n * sizeof(float))
     throw bad("holds " + std::to_string(bytes.size() - dataAt) + " bytes of image data, expected " +
-              std::to_string(2 * n * sizeof(float)) + " (truncated?)");
+              std::to_string(3 * n * sizeof(float)) + " (truncated?)");
   st.accum.resize(n);
   st.comp.resize(n);
+  st.half.resize(n);
   std::memcpy(st.accum.data(), bytes.data() + dataAt, n * sizeof(float));
   std::memcpy(st.comp.data(), bytes.data() + dataAt + n * sizeof(float), n * sizeof(float));
+  std::memcpy(st.half.data(), bytes.data() + dataAt + 2 * n * sizeof(float), n * sizeof(float));
   if (dataHash(st) != expected) throw bad("the image data fails its checksum (corrupted)");
   return ck;
 }

@@ -11,10 +11,11 @@
 namespace caustica::cli {
 
 constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
-constexpr int kCheckpointVersion = 1;
+// 2: adds the odd-sample half image (error estimate, adaptive sampling); version 1 files are refused.
+constexpr int kCheckpointVersion = 2;
 
 struct Checkpoint {
-  AccumulationState state;        // both rgba32f images, spp and the next global sample index
+  AccumulationState state;        // the three rgba32f images, spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
   std::string settingsText;       // checkpointSettingsText(...)

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "cli/environment_options.h"
 #include "scene/assets.h"
 #include "util/error.h"
 
@@ -130,6 +131,7 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
       {"--quiet", "-q", "", "print nothing but errors"},
   };
+  for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   return specs;
 }
@@ -288,6 +290,7 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
     note(!verbose, "--light-radius: " + std::to_string(before - ls.scene.punctualLights.size()) +
                        " point/spot light(s) made emissive spheres of radius " + opts.get("--light-radius", ""));
   }
+  applyEnvironmentOptions(opts, ls.scene, verbose);  // environment_options.cpp
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {
     if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");

@@ -6,19 +6,23 @@
 
 #include "cli/cli_common.h"
 #include "cli/commands.h"
+#include "cli/environment_options.h"
 #include "accel/bvh.h"
 #include "util/error.h"
 #include "accel/gpu_scene.h"
+#include "shading/microfacet.h"
 
 namespace caustica::cli {
 
 namespace {
 std::string materialKind(const Material& m) {
   std::string kind;
-  if (m.metallic >= 1.0f) kind = "mirror";
+  const bool rough = m.roughness * m.roughness >= kDeltaAlpha;  // GGX lobes (docs/materials.md)
+  if (m.metallic >= 1.0f) kind = rough ? "rough metal" : "mirror";
   else if (m.transmission > 0.0f) kind = m.transmission >= 1.0f && m.metallic <= 0.0f ? "glass" : "glass/diffuse mix";
   else if (m.metallic > 0.0f) kind = "mirror/diffuse mix";
-  else kind = "diffuse";
+  else kind = m.specularF90 > 0.0f ? "plastic (specular layer over diffuse)" : "diffuse";
+  if (rough && m.transmission > 0.0f && m.metallic < 1.0f) kind += " (rough glass)";
   if (m.dispersion > 0.0f) kind += " +dispersion";
   if (m.baseColor.a < 1.0f) kind += " +opacity";
   if (m.isEmissive()) kind = "emitter, " + kind;
@@ -33,6 +37,7 @@ std::string vec(const glm::vec3& v) {
 
 int cmdInfo(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {{"--camera", "", "N", "describe the scene's N-th camera (default 0)"}};
+  for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   Options opts("caustica info SCENE [--camera N] [options]",
                "Prints triangles, emitters (count, total power), punctual lights, materials by kind, bounds, camera,\n"
@@ -52,6 +57,7 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("triangles:  %zu\n", s.triangles.size());
   std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitters.size(),
               g.totalPower);
+  std::printf("lighting:   %s\n", lightingSummary(s, g.emitters.size()).c_str());
   // KHR_lights_punctual, with their share of the light choices (by power, punctual_lights.h).
   std::printf("punctual:   %zu light(s)%s\n", s.punctualLights.size(),
               s.punctualLights.empty() ? "" : " (point/spot: intensity in cd; directional: lux; chosen by power)");

@@ -2,14 +2,17 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 
 #include "cli/bench/reference_cache.h"
+#include "cli/budget_render.h"
 #include "cli/checkpoint.h"
 #include "cli/cli_common.h"
 #include "cli/commands.h"
 #include "util/error.h"
+#include "util/file_io.h"
 #include "image/image_io.h"
 #include "platform/context.h"
 
@@ -18,7 +21,13 @@ namespace caustica::cli {
 int cmdRender(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {
       {"--output", "-o", "FILE", "output image: .png (tone-mapped sRGB), .exr or .pfm (linear) (default caustica.png)"},
-      {"--spp", "", "N", "samples per pixel (default 64)"},
+      {"--spp", "", "N", "samples per pixel, a cap (default 64; with --time or --target-error: 65536)"},
+      {"--time", "", "SECONDS", "stop after about SECONDS (whichever of --spp, --time, --target-error comes first)"},
+      {"--target-error", "", "E",
+       "stop once the estimated relMSE of the image is at most E; samples go to the tiles whose error falls fastest (adaptive sampling)"},
+      {"--uniform", "", "", "with --target-error: keep sampling every pixel (no adaptive sampling)"},
+      {"--stats", "", "FILE.json",
+       "write seconds, spp_min, spp_mean, spp_max, estimated_relmse, nonfinite_samples, rays, samples"},
       {"--exposure", "", "STOPS", "PNG exposure in stops (default 0)"},
       {"--tonemap", "", "CURVE", "PNG tone curve: aces (default) or clamp"},
       {"--checkpoint", "", "SECONDS", "rewrite a checkpoint every SECONDS (atomically) and at the end"},
@@ -37,7 +46,20 @@ int cmdRender(const std::vector<std::string>& args) {
   bool quiet = opts.has("--quiet");
   std::string out = opts.get("--output", "caustica.png");
   checkImageExtension(out);  // fail before any work
-  int spp = opts.getInt("--spp", 64, 1, 1 << 24);
+  RenderBudget budget;
+  budget.seconds = opts.getDouble("--time", 0.0);
+  if (opts.has("--time") && !(budget.seconds > 0.0 && budget.seconds < 1e9))
+    throw Error("option --time needs a number of seconds above 0");
+  budget.targetError = opts.getDouble("--target-error", 0.0);
+  if (opts.has("--target-error") && !(budget.targetError > 0.0 && budget.targetError < 1e30))
+    throw Error("option --target-error needs a relMSE above 0 (e.g. 0.01)");
+  budget.adaptive = !opts.has("--uniform");
+  if (opts.has("--uniform") && !opts.has("--target-error")) throw Error("option --uniform needs --target-error");
+  const bool openEnded = opts.has("--time") || opts.has("--target-error");
+  int spp = opts.getInt("--spp", openEnded ? 65536 : 64, 1, 1 << 24);
+  budget.maxSpp = spp;
+  const std::string statsFile = opts.get("--stats", "");
+  if (opts.has("--stats")) checkWritableFile(statsFile, "stats");
   ToneMapSettings tone;
   tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", 0.0));
   tone.curve = parseToneCurve(opts.get("--tonemap", "aces"));
@@ -57,6 +79,8 @@ int cmdRender(const std::vector<std::string>& args) {
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
   if (opts.has("--light-radius")) settingsText += "light-radius " + opts.get("--light-radius", "") + "\n";  // changes the scene
+  settingsText += "environment " + ls.scene.environment.describe() + "\nbackground " + ls.scene.background.describe() +
+                  "\n";  // --env, --background change the image
   if (resumeFrom) {
     std::string diff = checkpointMismatch(*resumeFrom, sceneHash, settingsText);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
@@ -90,7 +114,8 @@ int cmdRender(const std::vector<std::string>& args) {
   hooks.checkpoint = saveCheckpoint;
   installInterruptHandlers();
   auto start = std::chrono::steady_clock::now();
-  const bool complete = renderWithProgress(renderer, spp, "", quiet, hooks);
+  const BudgetResult result = renderWithBudget(renderer, budget, "", quiet, hooks);
+  const bool complete = result.reason != StopReason::Interrupted;
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const RenderStats& st = renderer.stats();
   char line[256];
@@ -98,6 +123,17 @@ int cmdRender(const std::vector<std::string>& args) {
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
   writeImage(out, renderer.image(), tone);
+  {
+    const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);
+    note(quiet, "stats " + json);
+    if (!statsFile.empty())
+      writeFileAtomically(statsFile, ".tmp", [&](const std::string& tmp) {
+        std::ofstream f(tmp, std::ios::trunc);
+        f << json << "\n";
+        f.close();
+        if (!f) throw Error(tmp + ": cannot write the statistics");
+      });
+  }
   if (!complete) {
     // Always said, even with --quiet: it explains the exit status.
     std::string saved;

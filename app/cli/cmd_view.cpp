@@ -18,6 +18,7 @@ int cmdView(const std::vector<std::string>& args) {
       {"--screenshot", "", "FILE", "image written at exit: .png (tone-mapped), .exr or .pfm (linear)"},
       {"--budget-ms", "", "MS", "path-tracing GPU time per frame in milliseconds (default 30)"},
       {"--spp", "", "N", "stop refining at N samples per pixel (default: never)"},
+      {"--target-error", "", "E", "stop refining (and using the GPU) once the estimated relMSE is at most E; key G toggles"},
       {"--exposure", "", "STOPS", "display exposure in stops (default 0)"},
       {"--tonemap", "", "CURVE", "display tone curve: aces (default) or clamp"},
       {"--no-vsync", "", "", "do not wait for the display's vertical blank"},
@@ -44,6 +45,9 @@ int cmdView(const std::vector<std::string>& args) {
   config.budgetMs = opts.getDouble("--budget-ms", 30.0);
   if (config.budgetMs < 1.0 || config.budgetMs > 10000.0) throw Error("option --budget-ms needs 1 to 10000 milliseconds");
   config.maxSpp = opts.getInt("--spp", 0, 1, 1 << 24);
+  config.targetError = opts.getDouble("--target-error", 0.0);
+  if (opts.has("--target-error") && !(config.targetError > 0.0 && config.targetError < 1e30))
+    throw Error("option --target-error needs a relMSE above 0 (e.g. 0.01)");
   config.vsync = !opts.has("--no-vsync");
   config.preview = !opts.has("--no-preview");
   config.spinRadians = opts.getDouble("--spin", 0.0) * 3.14159265358979 / 180.0;

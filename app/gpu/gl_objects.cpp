@@ -102,6 +102,10 @@ void GlTexture::clear() {
   if (format_ == GL_RGBA32F) {
     std::vector<float> zeros(static_cast<std::size_t>(width_) * height_ * 4, 0.0f);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, zeros.data());
+  } else if (format_ == GL_R32UI) {
+    std::vector<GLuint> zeros(static_cast<std::size_t>(width_) * height_, 0u);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RED_INTEGER, GL_UNSIGNED_INT, zeros.data());
   } else {
     std::vector<unsigned char> zeros(static_cast<std::size_t>(width_) * height_ * 4, 0);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, zeros.data());
@@ -133,6 +137,22 @@ void GlTexture::uploadRgba32f(const std::vector<float>& rgba) {
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, rgba.data());
   glBindTexture(GL_TEXTURE_2D, 0);
   checkGlError("image upload");
+}
+
+void GlTexture::uploadR32uiRows(const std::vector<std::uint32_t>& values) {
+  const std::size_t rows = (values.size() + static_cast<std::size_t>(width_) - 1) / static_cast<std::size_t>(width_);
+  if (format_ != GL_R32UI || rows > static_cast<std::size_t>(height_))
+    throw Error("internal: uploadR32uiRows needs an r32ui texture with room for the values");
+  if (rows == 0) return;
+  std::vector<std::uint32_t> padded(values);
+  padded.resize(rows * static_cast<std::size_t>(width_), 0u);
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glBindTexture(GL_TEXTURE_2D, id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, static_cast<GLsizei>(rows), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                  padded.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("tile list upload");
 }
 
 GlProgram GlProgram::compileCompute(const std::string& source,

@@ -72,6 +72,8 @@ class GlTexture {
   std::vector<float> readRgba32f() const;  // width*height*4 floats, row 0 first
   // Replaces every texel of an rgba32f texture with `rgba` (width*height*4 floats, row 0 first).
   void uploadRgba32f(const std::vector<float>& rgba);
+  // r32ui texture: writes `values` row by row from texel (0, 0), the last row padded with zeros.
+  void uploadR32uiRows(const std::vector<std::uint32_t>& values);
   // Raster mode: an sRGB RGBA8 colour texture with mipmaps (rgba8: width*height*4 bytes, row 0 =
   // t 0), wrap GL_REPEAT / GL_MIRRORED_REPEAT / GL_CLAMP_TO_EDGE per axis, nearest or trilinear.
   static GlTexture createSrgb8(int width, int height, const void* rgba8, GLenum wrapS, GLenum wrapT, bool nearest);

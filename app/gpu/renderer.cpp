@@ -12,22 +12,51 @@
 
 namespace caustica {
 
-gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const Bounds& bounds) {
+gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const std::vector<PunctualLight>& punctual,
+                                  const Bounds& bounds) {
   gpu::PointLights pl{};
-  pl.count.x = static_cast<std::uint32_t>(std::min<size_t>(groups.size(), CAUSTICA_MAX_POINT_LIGHTS));
-  for (std::uint32_t i = 0; i < pl.count.x; ++i) {
-    const LightGroup& g = groups[i];
+  // Distance from a light to the farthest corner of the scene: the shadow maps' far plane.
+  auto farthest = [&](const glm::vec3& p) {
     float far = 0.0f;
     if (!bounds.empty())
       for (int c = 0; c < 8; ++c) {
         glm::vec3 corner((c & 1) ? bounds.max.x : bounds.min.x, (c & 2) ? bounds.max.y : bounds.min.y,
                          (c & 4) ? bounds.max.z : bounds.min.z);
-        far = std::max(far, glm::length(corner - g.position));
+        far = std::max(far, glm::length(corner - p));
       }
-    pl.light[i].position = glm::vec4(g.position, g.isotropic);
-    pl.light[i].intensity = glm::vec4(g.intensity, std::max(far * 1.01f, 1e-6f));
-    pl.light[i].axis = glm::vec4(g.axis, 0.0f);
+    return std::max(far * 1.01f, 1e-6f);
+  };
+  std::uint32_t n = 0;
+  for (const LightGroup& g : groups) {
+    if (n == CAUSTICA_MAX_POINT_LIGHTS) break;
+    gpu::PointLight& l = pl.light[n++];
+    l.position = glm::vec4(g.position, g.isotropic);
+    l.intensity = glm::vec4(g.intensity, farthest(g.position));
+    l.axis = glm::vec4(g.axis, 0.0f);
   }
+  // KHR_lights_punctual lights take the slots the emitter groups leave (most powerful first as listed).
+  // A directional light becomes a point light far away (100 scene radii) whose intensity gives the
+  // light's irradiance at the scene's centre.
+  const glm::vec3 centre = bounds.empty() ? glm::vec3(0.0f) : (bounds.min + bounds.max) * 0.5f;
+  const float radius = bounds.empty() ? 1.0f : std::max(glm::length(bounds.max - bounds.min) * 0.5f, 1e-6f);
+  for (const PunctualLight& p : punctual) {
+    if (n == CAUSTICA_MAX_POINT_LIGHTS) break;
+    gpu::PointLight& l = pl.light[n++];
+    glm::vec3 pos = p.position, intensity = p.intensity;
+    if (p.type == PunctualType::Directional) {
+      float d = 100.0f * radius;
+      pos = centre - p.direction * d;
+      intensity *= d * d;
+    }
+    l.position = glm::vec4(pos, 1.0f);  // isotropic
+    l.intensity = glm::vec4(intensity, farthest(pos));
+    if (p.type == PunctualType::Spot) {
+      l.position.w = 0.0f;
+      l.axis = glm::vec4(p.direction, 0.0f);
+      l.cone = glm::vec4(std::cos(p.outerCone), std::cos(p.innerCone), 1.0f, 0.0f);
+    }
+  }
+  pl.count.x = n;
   return pl;
 }
 
@@ -75,8 +104,9 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     sceneBounds.grow(g.nodes[0].bmin);
     sceneBounds.grow(g.nodes[0].bmax);
   }
-  pointLights_ = pointLightParams(lightGroups_, sceneBounds);
+  pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
+  environment_.upload(g, limits_, scene.path);
   allocateImages();
   prepareMode();  // compile now, so shader errors surface before rendering starts
 }
@@ -92,7 +122,7 @@ void Renderer::prepareMode() {
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
-  if (settings_.integrator == Integrator::Mis && !gpuScene_.emitters.empty()) {
+  if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
   }
@@ -159,6 +189,11 @@ void Renderer::uploadCasters() {
 void Renderer::allocateImages() {
   accum_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   comp_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
+  half_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
+  const int tiles = ((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X) *
+                    ((settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
+  tileList_ = GlTexture::create2D(CAUSTICA_TILE_LIST_WIDTH, (tiles + CAUSTICA_TILE_LIST_WIDTH - 1) / CAUSTICA_TILE_LIST_WIDTH,
+                                  GL_R32UI);
   display_ = GlTexture();
   reset();
 }
@@ -166,6 +201,8 @@ void Renderer::allocateImages() {
 void Renderer::reset() {
   accum_.clear();
   comp_.clear();
+  half_.clear();
+  useAllTiles();
   spp_ = 0;
   sampleBase_ = 0;
   stats_ = RenderStats{};
@@ -188,6 +225,44 @@ void Renderer::renderRows(int y0, int y1, int spp) {
     }
     return;
   }
+  dispatchSamples(spp, y0, y1, false);
+}
+
+void Renderer::renderPass(int spp) {
+  if (tileListActive_ && settings_.mode != RenderMode::Raster) {  // raster: one frame, no samples to spread
+    if (liveTiles_ > 0 && spp > 0) dispatchSamples(spp, 0, settings_.height, true);
+  } else {
+    renderRows(0, settings_.height, spp);
+  }
+  endPass(spp);
+}
+
+void Renderer::setLiveTiles(const std::vector<std::uint32_t>& tiles) {
+  const std::size_t capacity = static_cast<std::size_t>(tileList_.width()) * static_cast<std::size_t>(tileList_.height());
+  if (tiles.size() > capacity) throw Error("internal: more live tiles than the image has");
+  tileList_.uploadR32uiRows(tiles);
+  liveTiles_ = static_cast<std::uint32_t>(tiles.size());
+  tileListActive_ = true;
+}
+
+void Renderer::useAllTiles() {
+  tileListActive_ = false;
+  liveTiles_ = 0;
+}
+
+std::size_t Renderer::liveTileCount() const {
+  if (tileListActive_) return liveTiles_;
+  return static_cast<std::size_t>((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X) *
+         static_cast<std::size_t>((settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
+}
+
+ErrorEstimate Renderer::errorEstimate() const {
+  return estimateError(settings_.width, settings_.height, accum_.readRgba32f(), comp_.readRgba32f(), half_.readRgba32f(),
+                       CAUSTICA_WORKGROUP_X);
+}
+
+// One dispatch per sample: rows [y0, y1), or with `tiles` one work group per live tile.
+void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   const GlProgram& prog = program();
   const int w = settings_.width, h = settings_.height;
   float aspect = static_cast<float>(w) / static_cast<float>(h);
@@ -201,34 +276,39 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   fp.camUp = glm::vec4(up * tanHalf, 0.0f);
   fp.camForward = glm::vec4(fwd, 0.0f);
   fp.tile = glm::uvec4(0, y0, w, y1 - y0);
-  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 1.0f, 0.0f, 0.0f);
+  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 0.0f, 0.0f, 0.0f);
 
   prog.use();
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
   frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
+  environment_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
+  half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);
+  tileList_.bindImage(CAUSTICA_IMAGE_TILES, GL_READ_ONLY);
   // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested
   // loops together (65535 from the outermost loop's start) and silently stops beyond; a per-sample
   // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
   // depend on how samples are split.
   // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
   // (a sample traces at most 2 * maxDepth + 1 rays, plus one per alpha pass-through: at most 256).
-  const std::uint64_t raysPerDispatch =
-      static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0) * (2u * settings_.maxDepth + 1u + 256u);
+  const std::uint64_t pixelsPerDispatch =
+      tiles ? std::uint64_t(liveTiles_) * CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y
+            : static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0);
+  const std::uint64_t raysPerDispatch = pixelsPerDispatch * (2u * settings_.maxDepth + 1u + 256u);
+  // Tile lists: a 2D grid of work groups, since one dimension may hold only 65535 of them.
+  const GLuint groupsX = tiles ? std::min<GLuint>(liveTiles_, 65535u) : GLuint((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X);
+  const GLuint groupsY = tiles ? (liveTiles_ + groupsX - 1) / groupsX : GLuint((y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
   const int dispatchesPerRead = static_cast<int>(std::max<std::uint64_t>(1, (1ull << 31) / raysPerDispatch));
   for (int s = 0; s < spp; ++s) {
     if (s > 0 && s % dispatchesPerRead == 0) readCounters();
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, 0u, gpuScene_.emitters.size(),
-                            (settings_.integrator == Integrator::Mis ? gpu::kFlagMis : 0u) |
-                                (settings_.dispersion == DispersionMode::Spectral ? gpu::kFlagSpectral : 0u));
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), 0u);
     frameUbo_.update(0, sizeof fp, &fp);
-    glDispatchCompute((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
-                      (y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);
+    glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
   }
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
@@ -261,6 +341,7 @@ AccumulationState Renderer::saveAccumulation() const {
   st.sampleBase = sampleBase_;
   st.accum = accum_.readRgba32f();
   st.comp = comp_.readRgba32f();
+  st.half = half_.readRgba32f();
   return st;
 }
 
@@ -269,11 +350,12 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
   if (state.width != settings_.width || state.height != settings_.height)
     throw Error("the saved accumulation is " + std::to_string(state.width) + "x" + std::to_string(state.height) +
                 " but the renderer is " + std::to_string(settings_.width) + "x" + std::to_string(settings_.height));
-  if (state.accum.size() != n || state.comp.size() != n || state.spp < 0)
+  if (state.accum.size() != n || state.comp.size() != n || state.half.size() != n || state.spp < 0)
     throw Error("the saved accumulation is incomplete");
   reset();
   accum_.uploadRgba32f(state.accum);
   comp_.uploadRgba32f(state.comp);
+  half_.uploadRgba32f(state.half);
   spp_ = state.spp;
   sampleBase_ = state.sampleBase;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
 #include "accel/gpu_scene.h"
@@ -15,6 +16,7 @@
 #include "scene/scene.h"
 #include "gpu/render_settings.h"
 #include "gpu/shader_library.h"
+#include "image/error_estimate.h"
 #include "image/tonemap.h"
 #include "scene/light_groups.h"
 
@@ -22,9 +24,11 @@ namespace caustica {
 
 class RasterRenderer;
 
-// The PointLights UBO of the raster and Whitted modes for `groups` (at most CAUSTICA_MAX_POINT_LIGHTS),
-// with each light's shadow far distance reaching the farthest corner of `bounds`.
-gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const Bounds& bounds);
+// The PointLights UBO of the raster and Whitted modes: the emitter `groups`, then the scene's punctual
+// lights (at most CAUSTICA_MAX_POINT_LIGHTS in all), with each light's shadow far distance reaching the
+// farthest corner of `bounds`.
+gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const std::vector<PunctualLight>& punctual,
+                                  const Bounds& bounds);
 
 // Totals over everything rendered since the last reset.
 struct RenderStats {
@@ -39,6 +43,7 @@ struct AccumulationState {
   std::uint32_t sampleBase = 0;  // global index of the next sample (the RNG's sample dimension)
   std::vector<float> accum;     // rgba32f running sums (rgb radiance, a = sample count), width*height*4
   std::vector<float> comp;      // rgba32f Kahan compensation terms of those sums, width*height*4
+  std::vector<float> half;      // rgba32f sums of each pixel's odd-numbered samples (rgb) and their count (a)
 };
 
 class Renderer {
@@ -58,7 +63,17 @@ class Renderer {
   // Adds `spp` samples per pixel to rows [y0, y1). Cover every row, then call endPass(spp) once.
   void renderRows(int y0, int y1, int spp);
   void endPass(int spp);
-  void renderPass(int spp) { renderRows(0, settings_.height, spp); endPass(spp); }
+  // Adds `spp` samples to every pixel, or under adaptive sampling (setLiveTiles) to the live tiles only.
+  void renderPass(int spp);
+
+  // Adaptive sampling: from now on renderPass samples only these 8x8 tiles (packed x | y << 16, as
+  // liveTiles() returns them); an empty list samples nothing. useAllTiles() (and any reset) ends it.
+  void setLiveTiles(const std::vector<std::uint32_t>& tiles);
+  void useAllTiles();
+  bool adaptive() const { return tileListActive_; }
+  std::size_t liveTileCount() const;  // tiles renderPass samples
+  // The error estimate of the image so far (reads three images back; error_estimate.h).
+  ErrorEstimate errorEstimate() const;
 
   int samplesPerPixel() const { return spp_; }
   // Reads back both accumulation images and the sample counters (for checkpoints).
@@ -84,6 +99,7 @@ class Renderer {
   void prepareMode();  // compiles the current mode's compute variant, or builds the raster pipeline
   void allocateImages();
   void readCounters();
+  void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
 
   const ShaderLibrary& library_;
@@ -100,8 +116,11 @@ class Renderer {
   gpu::PointLights pointLights_{};
   GlBuffer pointLightUbo_;
   std::unique_ptr<RasterRenderer> raster_;  // built the first time the raster mode is used
+  EnvironmentTextures environment_;  // environment map, CDFs and UBO
   GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
-  GlTexture accum_, comp_, display_;
+  GlTexture accum_, comp_, half_, tileList_, display_;
+  std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_
+  bool tileListActive_ = false;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;
   int spp_ = 0;

@@ -90,6 +90,8 @@ const std::vector<std::string>& shaderFeatureNames() {
       "CAUSTICA_MIS",         // integrator: next-event estimation with MIS (else naive)
       "CAUSTICA_CASTERS",     // mis: diffuse bounces also aim at glass and mirror objects
       "CAUSTICA_SPECTRAL",    // dispersion by hero wavelengths (else one RGB channel per path)
+      "CAUSTICA_GGX",         // GGX lobes: rough metal, rough glass, specular layer over diffuse
+      "CAUSTICA_ENV",         // an environment light or a background colour (environment.glsl)
   };
   return names;
 }

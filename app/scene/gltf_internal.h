@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -134,6 +135,7 @@ class SceneBuilder {
   double unit(double v, const std::string& what);
   Material convertMaterial(int index);
   int texture(const tinygltf::TextureInfo& info, const std::string& at);
+  int texture(const tinygltf::NormalTextureInfo& info, const std::string& at);
   std::uint32_t defaultMaterial(const std::string& at);
 
   // ---- node hierarchy (gltf_nodes.cpp) ----
@@ -175,6 +177,8 @@ class SceneBuilder {
   const LoadOptions& options_;
   Scene& scene_;
   std::map<int, int> textureMap_;  // glTF texture index -> Scene::textures index (-1: ignored)
+  // Transformed references (KHR_texture_transform): glTF texture index and rows -> Scene::textures index.
+  std::map<std::pair<int, std::vector<float>>, int> transformMap_;
   int defaultMaterial_ = -1;
   std::size_t degenerate_ = 0;   // zero-area triangles dropped
   std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable

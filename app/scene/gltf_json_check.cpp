@@ -20,7 +20,8 @@ using Json = nlohmann::json;
 
 const char* const kSupportedExtensions[] = {
     "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
-    "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_lights_punctual"};
+    "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_texture_transform",
+    "KHR_lights_punctual"};
 
 std::string supportedExtensionList() {
   std::string out;
@@ -479,7 +480,16 @@ class JsonChecker {
     index(*info, iat, "texCoord");
     number(*info, iat, "scale");
     number(*info, iat, "strength");
-    object(*info, iat, "extensions");
+    if (const Json* ext = object(*info, iat, "extensions")) {
+      const std::string eat = join(iat, "extensions");
+      if (const Json* t = object(*ext, eat, "KHR_texture_transform")) {
+        const std::string tat = join(eat, "KHR_texture_transform");
+        numbers(*t, tat, "offset", 2);
+        number(*t, tat, "rotation");
+        numbers(*t, tat, "scale", 2);
+        index(*t, tat, "texCoord");
+      }
+    }
   }
 
   void checkMaterial(const Json& o, const std::string& at) const {
@@ -513,6 +523,13 @@ class JsonChecker {
       number(*e, vat, "attenuationDistance");
       numbers(*e, vat, "attenuationColor", 3);
       textureInfo(*e, vat, "thicknessTexture");
+    }
+    if (const Json* e = object(*ext, eat, "KHR_materials_specular")) {
+      const std::string sat = join(eat, "KHR_materials_specular");
+      number(*e, sat, "specularFactor");
+      numbers(*e, sat, "specularColorFactor", 3);
+      textureInfo(*e, sat, "specularTexture");
+      textureInfo(*e, sat, "specularColorTexture");
     }
     if (const Json* e = object(*ext, eat, "KHR_materials_dispersion"))
       number(*e, join(eat, "KHR_materials_dispersion"), "dispersion");

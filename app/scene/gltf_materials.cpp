@@ -90,17 +90,24 @@ Material SceneBuilder::convertMaterial(int index) {
   out.metallic = float(unit(pbr.metallicFactor, at + ".metallicFactor"));
   out.roughness = float(unit(pbr.roughnessFactor, at + ".roughnessFactor"));
   out.baseColorTexture = texture(pbr.baseColorTexture, at + ".baseColorTexture");
+  out.metallicRoughnessTexture = texture(pbr.metallicRoughnessTexture, at + ".metallicRoughnessTexture");
+  out.normalTexture = texture(m.normalTexture, at + ".normalTexture");
+  out.normalScale = float(m.normalTexture.scale);
+  if (!std::isfinite(out.normalScale)) fail(at + ".normalTexture.scale is not finite");
 
-  // Opacity: OPAQUE ignores alpha, MASK thresholds the factor, BLEND keeps it. Texture alpha is
-  // not used (docs/materials.md).
+  // Opacity: OPAQUE ignores alpha; MASK thresholds factor x texture alpha at alphaCutoff; BLEND keeps
+  // it as partial opacity (docs/materials.md). Without a texture the threshold is applied here.
   if (m.alphaMode == "OPAQUE" || m.alphaMode.empty()) {
     base.a = 1.0;
   } else if (m.alphaMode == "MASK") {
-    base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
+    if (!(m.alphaCutoff >= 0.0)) fail(at + ".alphaCutoff is " + num(m.alphaCutoff) + "; it must be >= 0");
+    if (out.baseColorTexture >= 0) out.alphaCutoff = float(m.alphaCutoff);
+    else base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
   } else if (m.alphaMode != "BLEND") {
     fail(at + ".alphaMode is \"" + oneLine(m.alphaMode) + "\"; it must be OPAQUE, BLEND or MASK");
   }
   out.baseColor = glm::vec4(base);
+  out.alphaFromTexture = out.baseColorTexture >= 0 && (m.alphaMode == "BLEND" || m.alphaMode == "MASK");
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength = radiance (linear).
   glm::dvec3 emissive(0.0);
@@ -126,9 +133,7 @@ Material SceneBuilder::convertMaterial(int index) {
   const auto ignore = [&](bool present, const char* what) {
     if (present) ignored += (ignored.empty() ? "" : ", ") + std::string(what);
   };
-  ignore(pbr.metallicRoughnessTexture.index >= 0, "metallicRoughnessTexture");
-  ignore(m.normalTexture.index >= 0, "normalTexture");
-  ignore(m.occlusionTexture.index >= 0, "occlusionTexture");
+  ignore(m.occlusionTexture.index >= 0, "occlusionTexture (ambient occlusion is what a path tracer computes)");
 
   if (const tinygltf::Value* t = extension(m.extensions, "KHR_materials_transmission")) {
     out.transmission = float(unit(extNumber(t, "transmissionFactor", 0.0), at + ".transmissionFactor"));
@@ -150,15 +155,37 @@ Material SceneBuilder::convertMaterial(int index) {
     if (!(distance > 0.0)) warn(at + ": attenuationDistance " + num(distance) + " is not positive; no absorption");
     else out.attenuationDistance = float(distance);
   }
+  // The dielectric specular layer over the diffuse base (glTF Appendix B fresnel_mix, with
+  // KHR_materials_specular): F0 = min(((ior - 1) / (ior + 1))^2 specularColorFactor, 1) specularFactor,
+  // F90 = specularFactor.
+  {
+    double specularFactor = 1.0;
+    glm::dvec3 specularColor(1.0);
+    if (const tinygltf::Value* sp = extension(m.extensions, "KHR_materials_specular")) {
+      specularFactor = unit(extNumber(sp, "specularFactor", 1.0), at + ".specularFactor");
+      if (extHas(sp, "specularColorFactor") && sp->Get("specularColorFactor").ArrayLen() == 3)
+        for (int c = 0; c < 3; ++c) {
+          const tinygltf::Value& v = sp->Get("specularColorFactor").Get(c);
+          double x = v.IsNumber() ? v.GetNumberAsDouble() : 1.0;
+          if (!(x >= 0.0) || !std::isfinite(x)) {
+            warn(at + ".specularColorFactor[" + str(std::uint64_t(c)) + "] is not a finite number >= 0; using 1");
+            x = 1.0;
+          }
+          specularColor[c] = x;
+        }
+      ignore(extHas(sp, "specularTexture"), "specularTexture");
+      ignore(extHas(sp, "specularColorTexture"), "specularColorTexture");
+    }
+    const double r = (double(out.ior) - 1.0) / (double(out.ior) + 1.0);
+    out.specularF0 = glm::vec3(glm::min(r * r * specularColor, glm::dvec3(1.0)) * specularFactor);
+    out.specularF90 = float(specularFactor);
+  }
   if (const tinygltf::Value* d = extension(m.extensions, "KHR_materials_dispersion")) {
     const double dispersion = extNumber(d, "dispersion", 0.0);
     if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
     else out.dispersion = float(dispersion);
   }
   if (!ignored.empty()) warn(at + " '" + oneLine(out.name) + "': ignoring unsupported " + ignored);
-  if (out.roughness > 0.0f && (out.metallic > 0.0f || out.transmission > 0.0f))
-    warn(at + " '" + oneLine(out.name) + "': roughness " + num(out.roughness) +
-         " on a mirror/glass component is rendered as perfectly smooth (rough lobes are not implemented)");
   return out;
 }
 
@@ -167,9 +194,49 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
   if (std::size_t(info.index) >= model_.textures.size())
     fail(at + ".index is " + str(std::uint64_t(info.index)) + ", but the file has " + str(model_.textures.size()) +
          " textures");
-  if (info.texCoord != 0)
-    warn(at + " uses TEXCOORD_" + str(std::uint64_t(info.texCoord)) + "; only TEXCOORD_0 is loaded and used instead");
-  if (info.extensions.count("KHR_texture_transform")) warn(at + ": KHR_texture_transform is not supported; ignored");
+  int texCoord = info.texCoord;
+  // KHR_texture_transform (the ratified form, whose example maps rotation pi/2, offset (0, 1), scale
+  // 0.5 to the lower left quadrant): u' = c sx u + s sy v + ox, v' = -s sx u + c sy v + oy.
+  glm::dvec3 row0(1.0, 0.0, 0.0), row1(0.0, 1.0, 0.0);
+  if (const tinygltf::Value* t = extension(info.extensions, "KHR_texture_transform")) {
+    const auto pair = [&](const char* key, glm::dvec2 fallback) {
+      if (!t->Has(key) || t->Get(key).ArrayLen() != 2) return fallback;
+      glm::dvec2 v;
+      for (int c = 0; c < 2; ++c) v[c] = t->Get(key).Get(c).IsNumber() ? t->Get(key).Get(c).GetNumberAsDouble() : fallback[c];
+      return v;
+    };
+    const glm::dvec2 offset = pair("offset", glm::dvec2(0.0)), scale = pair("scale", glm::dvec2(1.0));
+    const double rotation = extNumber(t, "rotation", 0.0);
+    if (!std::isfinite(offset.x) || !std::isfinite(offset.y) || !std::isfinite(scale.x) || !std::isfinite(scale.y) ||
+        !std::isfinite(rotation))
+      fail(at + ".extensions.KHR_texture_transform has a number that is not finite");
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    row0 = glm::dvec3(c * scale.x, s * scale.y, offset.x);
+    row1 = glm::dvec3(-s * scale.x, c * scale.y, offset.y);
+    if (t->Has("texCoord") && t->Get("texCoord").IsInt()) texCoord = t->Get("texCoord").GetNumberAsInt();
+  }
+  if (texCoord != 0)
+    warn(at + " uses TEXCOORD_" + str(std::uint64_t(std::max(texCoord, 0))) +
+         "; only TEXCOORD_0 is loaded and used instead");
+  if (row0 != glm::dvec3(1.0, 0.0, 0.0) || row1 != glm::dvec3(0.0, 1.0, 0.0)) {
+    tinygltf::TextureInfo plain = info;
+    plain.extensions.clear();
+    plain.texCoord = 0;
+    const int base = texture(plain, at);
+    if (base < 0) return -1;
+    const std::vector<float> key = {float(row0.x), float(row0.y), float(row0.z), float(row1.x), float(row1.y), float(row1.z)};
+    const auto found = transformMap_.find({info.index, key});
+    if (found != transformMap_.end()) return found->second;
+    Texture shared = scene_.textures[std::size_t(base)];
+    shared.rgba.clear();
+    shared.pixelSource = base;
+    shared.uvRow0 = glm::vec3(row0);
+    shared.uvRow1 = glm::vec3(row1);
+    scene_.textures.push_back(std::move(shared));
+    const int result = int(scene_.textures.size() - 1);
+    transformMap_[{info.index, key}] = result;
+    return result;
+  }
   const auto cached = textureMap_.find(info.index);
   if (cached != textureMap_.end()) return cached->second;
 
@@ -211,6 +278,14 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
   }
   textureMap_[info.index] = result;
   return result;
+}
+
+int SceneBuilder::texture(const tinygltf::NormalTextureInfo& info, const std::string& at) {
+  tinygltf::TextureInfo t;
+  t.index = info.index;
+  t.texCoord = info.texCoord;
+  t.extensions = info.extensions;
+  return texture(t, at);
 }
 
 std::uint32_t SceneBuilder::defaultMaterial(const std::string& at) {

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/environment.h"
 #include "scene/punctual_lights.h"
 
 namespace caustica {
@@ -20,15 +21,32 @@ struct Texture {
   bool repeatS = true, repeatT = true;      // glTF wrap: REPEAT (or MIRRORED_REPEAT with mirror*) else CLAMP
   bool mirrorS = false, mirrorT = false;    // MIRRORED_REPEAT
   bool nearest = false;                     // magFilter NEAREST
+  // KHR_texture_transform of the reference that uses this entry: texture coordinates become
+  // (dot(uvRow0, (u, v, 1)), dot(uvRow1, (u, v, 1))) before the lookup. A transformed reference gets
+  // its own entry, which shares the texels of entry `pixelSource` (its rgba is then empty).
+  glm::vec3 uvRow0{1.0f, 0.0f, 0.0f};
+  glm::vec3 uvRow1{0.0f, 1.0f, 0.0f};
+  int pixelSource = -1;
 };
 
 // Material after the contract in docs/materials.md. All colours linear.
 struct Material {
   std::string name;
-  glm::vec4 baseColor{1.0f};          // rgb: baseColorFactor, a: opacity (alpha; 1 for OPAQUE)
+  glm::vec4 baseColor{1.0f};          // rgb: baseColorFactor, a: baseColorFactor.a (BLEND, MASK) or 1 (OPAQUE)
   int baseColorTexture = -1;          // index into Scene::textures, -1 = none
-  float metallic = 0.0f;              // mirror weight in [0,1]
-  float roughness = 1.0f;             // kept for information; mirrors and glass are treated as smooth
+  float metallic = 0.0f;              // metal weight in [0,1]
+  float roughness = 0.0f;             // glTF roughness in [0,1]; GGX alpha = roughness^2 (docs/materials.md). The glTF
+                                      // loader always sets it (glTF's default is 1); 0 keeps C++-built metals and glass smooth
+  int metallicRoughnessTexture = -1;  // index into Scene::textures (linear: B = metallic, G = roughness), -1 = none
+  int normalTexture = -1;             // index into Scene::textures (linear, tangent space), -1 = none
+  float normalScale = 1.0f;           // normalTexture.scale: scales the map's x and y
+  // Dielectric specular layer over the diffuse base (glTF fresnel_mix): reflectance at normal and grazing
+  // incidence. The glTF loader sets glTF's F0 = ((ior-1)/(ior+1))^2 (times KHR_materials_specular) and
+  // F90 = specularFactor; F90 = 0 (the default of this struct) means a purely Lambertian base.
+  glm::vec3 specularF0{0.0f};
+  float specularF90 = 0.0f;
+  bool alphaFromTexture = false;      // BLEND or MASK with a base-colour texture: its alpha multiplies baseColor.a
+  float alphaCutoff = -1.0f;          // alphaMode MASK: opaque where alpha >= cutoff, else absent; < 0: not MASK
   float transmission = 0.0f;          // KHR_materials_transmission: dielectric weight in [0,1]
   float ior = 1.5f;                   // KHR_materials_ior, at 587.6 nm
   float dispersion = 0.0f;            // KHR_materials_dispersion (20 / Abbe number), 0 = none
@@ -91,14 +109,19 @@ struct Scene {
   // the world origin than its own size, the loader subtracts its centre from every position and
   // camera before converting to float, so it keeps full float precision; 0 for other scenes.
   glm::dvec3 origin{0.0};
+  // Light from infinity and what escaping camera rays see (scene/environment.h, docs/lighting.md).
+  // Set from the command line (--env, --background), not from the file.
+  Environment environment;
+  Background background;
 };
 
-// Whether anything in the scene emits light: an emissive material on a triangle or a punctual light.
+// Whether anything in the scene emits light: an emissive material on a triangle, a punctual light or
+// an environment that emits.
 inline bool sceneHasLights(const Scene& s) {
   if (!s.punctualLights.empty()) return true;
   for (const Triangle& t : s.triangles)
     if (t.material < s.materials.size() && s.materials[t.material].isEmissive()) return true;
-  return false;
+  return s.environment.emits();
 }
 
 // What loadScene accepts from a scene file it does not trust (docs/untrusted-input.md). Each limit

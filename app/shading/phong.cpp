@@ -1,12 +1,15 @@
 // phong.cpp — the point-light lobe and Phong BRDF of the raster and Whitted modes (twins of point_lights.glsl).
 #include "shading/phong.h"
 
+#include "scene/punctual_lights.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace caustica {
 
 glm::vec3 pointLightIntensity(const gpu::PointLight& l, const glm::vec3& w) {
+  if (l.cone.z > 0.5f) return glm::vec3(l.intensity) * spotFalloff(glm::dot(glm::vec3(l.axis), w), l.cone.x, l.cone.y);
   return glm::vec3(l.intensity) * (std::max(0.0f, glm::dot(glm::vec3(l.axis), w)) + l.position.w);
 }
 

@@ -1,17 +1,58 @@
-// materials.glsl — the material contract (docs/materials.md) on the GPU: base colour, emission,
-// lobe choice (mirror weight m, glass (1-m)t, diffuse (1-m)(1-t)) and the smooth dielectric.
-
-const uint kLobeDiffuse = 0u;
-const uint kLobeMirror = 1u;
-const uint kLobeGlass = 2u;
+// materials.glsl — the material contract (docs/materials.md) on the GPU: base colour, opacity,
+// metallic and roughness, emission, normal maps, lobe choice (metal weight m, glass (1-m)t, diffuse
+// (1-m)(1-t); each a delta lobe or a GGX lobe from microfacet.glsl) and the smooth dielectric.
 
 // Linear base colour (rgb) and opacity (a) at uv.
 vec4 materialBaseColor(Material m, vec2 uv) {
   vec4 c = m.baseColor;
 #ifdef CAUSTICA_TEXTURES
-  if (m.tex.x != kInvalidIndex) c.rgb *= sampleTexture(m.tex.x, uv).rgb;
+  if (m.tex.x != kInvalidIndex) {
+    vec4 t = sampleTexture(m.tex.x, uv);
+    c.rgb *= t.rgb;
+    if ((m.tex.z & kMatAlphaTexture) != 0u) c.a *= t.a;  // BLEND and MASK only; OPAQUE ignores alpha
+    if ((m.tex.z & kMatAlphaMask) != 0u) c.a = c.a >= uintBitsToFloat(m.tex2.w) ? 1.0 : 0.0;
+  }
 #endif
   return c;
+}
+
+// Metallic (x) and roughness (y) at uv: the factors times the metallicRoughness texture (B, G; linear).
+vec2 materialMetalRough(Material m, vec2 uv) {
+  vec2 mr = m.params.xy;
+#ifdef CAUSTICA_TEXTURES
+  if (m.tex2.x != kInvalidIndex) mr *= sampleDataTexture(m.tex2.x, uv).bg;
+#endif
+  return mr;
+}
+
+// The shading normal after the material's normal map (tangent space, glTF: +x along +u, +y towards
+// -v, i.e. up in the image). n: interpolated unit normal on the front side; p0..p2 and uv0..uv2 the
+// triangle's corners: the tangent is the triangle's dp/du made orthogonal to n (one tangent per
+// triangle; the file's TANGENT attribute is not read). Returns n where the map or the frame is unusable.
+vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2) {
+#ifdef CAUSTICA_TEXTURES
+  if (m.tex2.y == kInvalidIndex) return n;
+  vec3 dp1 = p1 - p0, dp2 = p2 - p0;
+  vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+  float det = d1.x * d2.y - d1.y * d2.x;
+  if (!(abs(det) > 0.0)) return n;
+  vec3 dpdu = (dp1 * d2.y - dp2 * d1.y) / det;
+  vec3 dpdv = (dp2 * d1.x - dp1 * d2.x) / det;
+  vec3 t = dpdu - n * dot(n, dpdu);
+  float tLen = length(t);
+  if (!(tLen > 0.0)) return n;
+  t /= tLen;
+  vec3 b = cross(n, t);
+  if (dot(b, dpdv) > 0.0) b = -b;  // bitangent points towards -v (up in the image), mirrored maps included
+  vec3 c = sampleDataTexture(m.tex2.y, uv).xyz * 2.0 - 1.0;
+  float scale = uintBitsToFloat(m.tex2.z);
+  c.xy *= scale;
+  vec3 mapped = c.x * t + c.y * b + c.z * n;
+  float len = length(mapped);
+  return len > 0.0 && dot(mapped, n) > 0.0 ? mapped / len : n;
+#else
+  return n;
+#endif
 }
 
 // Emitted radiance at uv (front face only unless double-sided; the caller checks the side).
@@ -26,17 +67,43 @@ vec3 materialEmission(Material m, vec2 uv) {
 bool isEmissive(Material m) { return maxComponent(m.emission.rgb) > 0.0; }
 
 // Picks one lobe with probability equal to its weight, so lobe weights cancel in the estimator.
-uint chooseLobe(Material m, float u) {
-  float metal = 0.0, trans = 0.0;
-#ifdef CAUSTICA_MIRROR
-  metal = m.params.x;
+// metal: the metallic value at the hit (materialMetalRough). With CAUSTICA_GGX a metal or glass with
+// GGX alpha = roughness^2 >= kDeltaAlpha takes its rough lobe, and a diffuse part with a specular
+// layer (F90 > 0) the plastic lobe; otherwise the delta lobes and the Lambertian lobe as before.
+// (Glass of ior 1 stays the delta lobe: it passes light straight through, and the generalised half
+// vector of rough refraction does not exist there.)
+uint chooseLobe(Material m, float metal, float roughness, float u) {
+  float trans = 0.0;
+#ifndef CAUSTICA_MIRROR
+  metal = 0.0;
 #endif
 #ifdef CAUSTICA_GLASS
   trans = m.params.z;
 #endif
-  if (u < metal) return kLobeMirror;
-  if (u < metal + (1.0 - metal) * trans) return kLobeGlass;
-  return kLobeDiffuse;
+  uint lobe = kLobeDiffuse;
+  if (u < metal) lobe = kLobeMirror;
+  else if (u < metal + (1.0 - metal) * trans) lobe = kLobeGlass;
+#ifdef CAUSTICA_GGX
+  bool rough = roughness * roughness >= kDeltaAlpha;
+  if (lobe == kLobeMirror && rough) lobe = kLobeConductor;
+  else if (lobe == kLobeGlass && rough && m.params.w != 1.0) lobe = kLobeRoughGlass;  // ior 1: no interface
+  else if (lobe == kLobeDiffuse && m.specular.w > 0.0) lobe = kLobePlastic;
+#endif
+  return lobe;
+}
+
+// The GGX lobe `lobe` of material m at a hit: base colour C, roughness, eta (rough glass: n beyond
+// the surface / n on the ray's side).
+Bsdf makeBsdf(Material m, uint lobe, vec3 color, float roughness, float eta) {
+  Bsdf b;
+  b.lobe = lobe;
+  b.color = color;
+  b.alpha = roughness * roughness;
+  if (lobe == kLobePlastic) b.alpha = max(b.alpha, kMinPlasticAlpha);
+  b.eta = eta;
+  b.f0 = m.specular.rgb;
+  b.f90 = m.specular.w;
+  return b;
 }
 
 // Smooth dielectric: d is the incident direction (unit, towards the surface), n the unit normal

@@ -1,11 +1,13 @@
 // point_lights.glsl — the point lights of the raster and Whitted modes (PointLights UBO, gpu_layout.h):
 // emissive triangles grouped at their power-weighted centres (app/scene/light_groups.h).
 // Include gpu_layout.h first (bindings.glsl does).
+#include "punctual.glsl"  // spotFalloff (its UBO only under CAUSTICA_PUNCTUAL)
 
 layout(std140, binding = CAUSTICA_BINDING_POINT_LIGHTS) uniform PointLightBlock { PointLights pointLights; };
 
 // Radiant intensity (W sr^-1 per channel) of light l towards unit direction w leaving it.
 vec3 pointLightIntensity(PointLight l, vec3 w) {
+  if (l.cone.z > 0.5) return l.intensity.rgb * spotFalloff(dot(l.axis.xyz, w), l.cone.x, l.cone.y);
   return l.intensity.rgb * (max(0.0, dot(l.axis.xyz, w)) + l.position.w);
 }
 

@@ -15,25 +15,33 @@ int wrapCoord(int i, int n, bool repeat, bool mirror) {
   return clamp(i, 0, n - 1);
 }
 
-vec4 fetchTexel(TexInfo info, int x, int y) {
+// srgb: colour textures (base colour, emission) are sRGB-encoded; data textures (metallicRoughness,
+// normal) are linear and are read as stored.
+vec4 fetchTexel(TexInfo info, int x, int y, bool srgb) {
   uint w = info.width, h = info.height;
   x = wrapCoord(x, int(w), (info.flags & 1u) != 0u, (info.flags & 4u) != 0u);
   y = wrapCoord(y, int(h), (info.flags & 2u) != 0u, (info.flags & 8u) != 0u);
   vec4 c = unpackUnorm4x8(texels[info.offset + uint(y) * w + uint(x)]);
-  return vec4(srgbToLinear(c.rgb), c.a);
+  return srgb ? vec4(srgbToLinear(c.rgb), c.a) : c;
 }
 
-// Linear RGB and alpha of texture `index` at uv.
-vec4 sampleTexture(uint index, vec2 uv) {
+vec4 sampleTextureAs(uint index, vec2 uv, bool srgb) {
   TexInfo info = texInfo[index];
+  uv = vec2(dot(info.uvRow0.xyz, vec3(uv, 1.0)), dot(info.uvRow1.xyz, vec3(uv, 1.0)));  // KHR_texture_transform
   // Keep the coordinate bounded before converting to int (huge uv would overflow).
   vec2 st = uv * vec2(float(info.width), float(info.height));
   st = clamp(st, vec2(-1.0e7), vec2(1.0e7));
-  if ((info.flags & 16u) != 0u) return fetchTexel(info, int(floor(st.x)), int(floor(st.y)));
+  if ((info.flags & 16u) != 0u) return fetchTexel(info, int(floor(st.x)), int(floor(st.y)), srgb);
   st -= 0.5;
   vec2 f = fract(st);
   int x0 = int(floor(st.x)), y0 = int(floor(st.y));
-  vec4 a = mix(fetchTexel(info, x0, y0), fetchTexel(info, x0 + 1, y0), f.x);
-  vec4 b = mix(fetchTexel(info, x0, y0 + 1), fetchTexel(info, x0 + 1, y0 + 1), f.x);
+  vec4 a = mix(fetchTexel(info, x0, y0, srgb), fetchTexel(info, x0 + 1, y0, srgb), f.x);
+  vec4 b = mix(fetchTexel(info, x0, y0 + 1, srgb), fetchTexel(info, x0 + 1, y0 + 1, srgb), f.x);
   return mix(a, b, f.y);
 }
+
+// Linear RGB and alpha of colour texture `index` at uv (decoded from sRGB).
+vec4 sampleTexture(uint index, vec2 uv) { return sampleTextureAs(index, uv, true); }
+
+// The stored values of data texture `index` at uv, in [0, 1] (no sRGB decoding).
+vec4 sampleDataTexture(uint index, vec2 uv) { return sampleTextureAs(index, uv, false); }

@@ -29,6 +29,9 @@ using uint = std::uint32_t;
 #define CAUSTICA_SSBO_COUNT 8         // SSBO bindings used by the path tracer
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
 #define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
+#define CAUSTICA_BINDING_ENVIRONMENT 3  // UBO: EnvironmentParams (environment map size, rotation, background)
+#define CAUSTICA_TEXUNIT_ENV_MAP 0      // texture unit: rgba32f environment map (rgb radiance, a conditional CDF)
+#define CAUSTICA_TEXUNIT_ENV_MARGINAL 1 // texture unit: rgba32f height x 1 (r: marginal CDF over rows)
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
@@ -37,6 +40,9 @@ using uint = std::uint32_t;
 #define CAUSTICA_IMAGE_ACCUM 0        // image unit: rgba32f running sum of radiance
 #define CAUSTICA_IMAGE_COMP 1         // image unit: rgba32f Kahan compensation of the sum
 #define CAUSTICA_IMAGE_DISPLAY 2      // image unit: rgba8 tone-mapped display image
+#define CAUSTICA_IMAGE_HALF 3         // image unit: rgba32f sum (rgb) and count (a) of each pixel's odd-numbered samples (error estimate)
+#define CAUSTICA_IMAGE_TILES 4        // image unit: r32ui list of live tiles (adaptive sampling), x | y << 16 in tiles
+#define CAUSTICA_TILE_LIST_WIDTH 1024 // texels per row of the live-tile list image
 #define CAUSTICA_WORKGROUP_X 8        // compute work-group size in pixels
 #define CAUSTICA_WORKGROUP_Y 8
 #define CAUSTICA_BVH_STACK 64         // traversal stack entries; the builder guarantees depth < this
@@ -55,10 +61,13 @@ CAUSTICA_CONST uint kMatSpotEmitter = 256u;
 CAUSTICA_CONST uint kPunctualPoint = 0u;
 CAUSTICA_CONST uint kPunctualSpot = 1u;
 CAUSTICA_CONST uint kPunctualDirectional = 2u;
+CAUSTICA_CONST uint kMatAlphaTexture = 8u;   // alphaMode BLEND or MASK: the base-colour texture's alpha multiplies baseColor.a
+CAUSTICA_CONST uint kMatAlphaMask = 16u;     // alphaMode MASK with a texture: opaque where alpha >= cutoff (tex2.w), else absent
 
-// FrameParams.options.w flags
-CAUSTICA_CONST uint kFlagMis = 1u;           // next-event estimation + MIS (else pure BSDF sampling)
-CAUSTICA_CONST uint kFlagSpectral = 2u;      // hero-wavelength dispersion (else one RGB channel per path)
+// EnvironmentParams.size.z: what camera rays that leave the scene see
+CAUSTICA_CONST uint kBackgroundEnvironment = 0u;  // the environment (black if there is none)
+CAUSTICA_CONST uint kBackgroundColor = 1u;        // EnvironmentParams.background.rgb
+CAUSTICA_CONST uint kBackgroundTransparent = 2u;  // nothing: radiance 0 and alpha 0
 
 // ---- SSBO structs ----------------------------------------------------------------------------
 // 32-byte BVH node: bounds and either two children (left, left+1) or a range of triangles.
@@ -84,13 +93,16 @@ struct TriShade {
   vec4 vt;  // x,y,z: v of texcoords 0,1,2; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0
 };
 
-// Material after the glTF material contract (docs/materials.md), 80 bytes.
+// Material after the glTF material contract (docs/materials.md), 112 bytes.
 struct Material {
   vec4 baseColor;     // rgb: linear base colour factor; a: opacity (1 = opaque)
   vec4 emission;      // rgb: emitted radiance (linear, W sr^-1 m^-2 relative units); w: unused
-  vec4 params;        // x: metallic (mirror weight), y: roughness, z: transmission, w: ior at 587.6 nm
+  vec4 params;        // x: metallic (metal weight), y: roughness (GGX alpha = y^2), z: transmission, w: ior at 587.6 nm
   vec4 absorption;    // rgb: absorption coefficient sigma_a per scene unit (Beer–Lambert); w: abbe number V (0 = none)
   uvec4 tex;          // x: base-colour texture index, y: emissive texture index (kInvalidIndex = none), z: flags, w unused
+  vec4 specular;      // rgb: F0 of the dielectric specular layer over the diffuse base; w: its F90 (0 = Lambertian base)
+  uvec4 tex2;         // x: metallicRoughness texture, y: normal texture (kInvalidIndex = none); z: normal scale,
+                      // w: alpha cutoff (both float bits)
 };
 
 // One alias-table slot over emissive triangles (16 bytes).
@@ -101,12 +113,14 @@ struct Emitter {
   float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
 };
 
-// A texture inside the texel SSBO (16 bytes).
+// A texture inside the texel SSBO (48 bytes). Several may share texels (KHR_texture_transform).
 struct TexInfo {
   uint offset;   // first texel in the texel SSBO
   uint width;    // texels
   uint height;   // texels
   uint flags;    // bit 0: repeat S (else clamp), bit 1: repeat T, bit 2: mirrored S, bit 3: mirrored T, bit 4: nearest filter
+  vec4 uvRow0;   // xyz: u' = dot(xyz, (u, v, 1)) (KHR_texture_transform; identity (1, 0, 0)); w unused
+  vec4 uvRow1;   // xyz: v' = dot(xyz, (u, v, 1)) (identity (0, 1, 0)); w unused
 };
 
 // Statistics the shader writes atomically.
@@ -140,9 +154,11 @@ struct FrameParams {
   vec4 camUp;       // xyz: up axis scaled by tan(yfov/2)
   vec4 camForward;  // xyz: unit viewing direction
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
-  uvec4 options;    // x: max depth, y: unused (one sample per dispatch), z: emitter count, w: kFlag* bits
+  uvec4 options;    // x: max depth, y: live tiles in the tile list (0: the dispatch covers `tile`; else one
+                    //    8x8 work group per listed tile, adaptive sampling), z: emitter count, w: unused (the integrator
+                    //    and dispersion mode are shader variants, not flags)
   uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
-  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); y: exposure (display); zw unused
+  vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); yzw unused
 };
 
 // Caustic casters: bounding spheres of the scene's specular objects (glass, mirrors), aimed at from
@@ -156,14 +172,26 @@ struct CasterParams {
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
 };
 
+// The environment light (scene/environment.h; glsl/lib/environment.glsl), std140. Its texels and
+// CDFs live in two textures (CAUSTICA_TEXUNIT_ENV_*): no ninth SSBO.
+struct EnvironmentParams {
+  uvec4 size;        // x, y: map width and height in texels (0 = no environment); z: kBackground*; w unused
+  vec4 rotation;     // x, y: cos and sin of the map's rotation about +Y; zw unused
+  vec4 background;   // rgb: linear radiance camera rays see for kBackgroundColor; a unused
+};
+
 // The raster and Whitted modes light the scene with point lights: the emissive triangles grouped
 // into at most CAUSTICA_MAX_POINT_LIGHTS lights at their power-weighted centres (app/scene/light_groups.h).
 // Radiant intensity towards unit direction w (from the light): intensity.rgb * (max(0, dot(axis.xyz, w)) + position.w),
-// so a flat one-sided emitter keeps its cosine lobe and a closed one shines evenly (std140).
+// so a flat one-sided emitter keeps its cosine lobe and a closed one shines evenly; a spot light
+// (cone.z = 1) gives intensity.rgb * spotFalloff(dot(axis.xyz, w), cone.x, cone.y) instead (std140).
+// KHR_lights_punctual lights join the groups: point (axis 0, position.w 1), spot, and directional
+// (a point far away, docs/render-modes.md).
 struct PointLight {
   vec4 position;   // xyz: world-space position; w: isotropic part of the lobe (0 flat .. 1/4 closed)
   vec4 intensity;  // rgb: sum of emitted radiance * area (* 2 if double-sided); w: shadow far distance (scene units)
-  vec4 axis;       // xyz: mean emitter normal, length = the flat part of the lobe (0..1); w: unused
+  vec4 axis;       // xyz: mean emitter normal, length = the flat part of the lobe (0..1); spot: unit cone axis; w: unused
+  vec4 cone;       // spot only: x: cos(outer cone), y: cos(inner cone), z: 1 (else 0); w: unused
 };
 struct PointLights {
   uvec4 count;                                  // x: lights in use (0..CAUSTICA_MAX_POINT_LIGHTS); yzw unused
@@ -185,16 +213,17 @@ struct PunctualParams {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(PointLight) == 48, "PointLight must be 48 bytes (std140)");
-static_assert(sizeof(PointLights) == 16 + 48 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
+static_assert(sizeof(EnvironmentParams) == 48, "EnvironmentParams must be 48 bytes (std140)");
+static_assert(sizeof(PointLight) == 64, "PointLight must be 64 bytes (std140)");
+static_assert(sizeof(PointLights) == 16 + 64 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
 static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");
-static_assert(sizeof(Material) == 80, "Material must be 80 bytes (std430)");
+static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
-static_assert(sizeof(TexInfo) == 16, "TexInfo must be 16 bytes (std430)");
+static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
 static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");

@@ -6,6 +6,7 @@
 #include "../lib/spawn.glsl"
 #include "../lib/sampling.glsl"
 #include "../lib/spectral.glsl"
+#include "../lib/microfacet.glsl"
 #include "../lib/materials.glsl"
 #include "../lib/casters.glsl"
 #include "../lib/punctual.glsl"  // without CAUSTICA_PUNCTUAL: spotFalloff only (no UBO)
@@ -46,7 +47,24 @@ const uint kPrepareCasters = 18u;
 const uint kDiffuseDirectionPdf = 19u;
 const uint kSampleDiffuseDirection = 20u;
 const uint kHitPointError = 21u;
-const uint kSpotFalloff = 22u;
+const uint kGgx = 22u;
+const uint kGgxSampleVisibleNormal = 23u;
+const uint kBsdfEvalPdf = 24u;
+const uint kBsdfSample = 25u;
+const uint kSpotFalloff = 26u;
+
+// The Bsdf of records for kBsdfEvalPdf and kBsdfSample: a[0].w = alpha, a[1].w = eta,
+// a[2] = (color, lobe), a[3].xy = (f0 grey, f90).
+Bsdf recordBsdf(vec4 a[kInWords]) {
+  Bsdf b;
+  b.lobe = uint(a[2].w);
+  b.color = a[2].xyz;
+  b.alpha = a[0].w;
+  b.eta = a[1].w;
+  b.f0 = vec3(a[3].x);
+  b.f90 = a[3].y;
+  return b;
+}
 
 uvec4 bits(vec4 v) { return floatBitsToUint(v); }
 uvec4 bits(vec3 v, float w) { return floatBitsToUint(vec4(v, w)); }
@@ -136,6 +154,22 @@ void main() {
   } else if (function == kSampleDiffuseDirection) {  // prepareCasters as above, a[1].w = uPick, a[3].xy = u
     prepareCasters(a[0].xyz, a[1].xyz, a[0].w);
     o[0] = bits(sampleDiffuseDirection(a[1].xyz, a[1].w, a[3].xy), 0.0);
+  } else if (function == kGgx) {  // a[0] = (h, alpha), a[1].xyz = wi: D(h), Lambda(h), G1(h), G2(h, wi)
+    o[0] = bits(vec4(ggxD(a[0].xyz, a[0].w), ggxLambda(a[0].xyz, a[0].w), ggxG1(a[0].xyz, a[0].w),
+                     ggxG2(a[0].xyz, a[1].xyz, a[0].w)));
+  } else if (function == kGgxSampleVisibleNormal) {  // a[0] = (wo, alpha), a[1].xy = u: h, its pdf
+    vec3 h = ggxSampleVisibleNormal(a[0].xyz, a[0].w, a[1].xy);
+    o[0] = bits(h, ggxVisibleNormalPdf(a[0].xyz, h, a[0].w));
+  } else if (function == kBsdfEvalPdf) {  // a[0].xyz = wo, a[1].xyz = wi: f, pdf
+    Bsdf b = recordBsdf(a);
+    o[0] = bits(bsdfEval(b, a[0].xyz, a[1].xyz), bsdfPdf(b, a[0].xyz, a[1].xyz));
+  } else if (function == kBsdfSample) {  // a[0].xyz = wo, a[1].xyz = u: wi, pdf, weight, transmitted, ok
+    BsdfSample bs;
+    bool ok = bsdfSample(recordBsdf(a), a[0].xyz, a[1].xyz, bs);
+    o[0] = bits(bs.wi, bs.pdf);
+    o[1] = bits(bs.weight, 0.0);
+    o[2].x = bit(bs.transmitted);
+    o[2].y = bit(ok);
   }
 
   for (uint k = 0u; k < kOutWords; ++k) outRec[i * kOutWords + k] = o[k];

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "accel/gpu_scene.h"
@@ -119,4 +120,56 @@ TEST_CASE("a material no triangle uses does not switch features on") {
   s.triangles = {quadTri(1, 0, 0, false)};
   CHECK_FALSE(sceneFeatures(s).mirror);
   CHECK(sceneFeatures(s).defines().empty());
+}
+
+TEST_CASE("GGX materials: rough lobes switch CAUSTICA_GGX on; specular layer, data textures and shared texels are packed") {
+  Scene s;
+  Material smoothMirror;
+  smoothMirror.metallic = 1.0f;
+  smoothMirror.roughness = 0.03f;  // alpha 9e-4 < kDeltaAlpha: still the delta mirror
+  s.materials = {smoothMirror};
+  s.triangles = {quadTri(1, 0, 0, false)};
+  CHECK_FALSE(packScene(s, buildBvh(s.triangles)).features.ggx);
+  s.materials[0].roughness = 0.04f;  // alpha 1.6e-3: GGX
+  CHECK(packScene(s, buildBvh(s.triangles)).features.ggx);
+
+  Material plastic;
+  plastic.specularF0 = glm::vec3(0.04f, 0.03f, 0.02f);
+  plastic.specularF90 = 0.5f;
+  plastic.metallicRoughnessTexture = 1;
+  plastic.normalTexture = 0;
+  plastic.normalScale = 0.25f;
+  plastic.baseColorTexture = 0;
+  plastic.alphaFromTexture = true;
+  plastic.alphaCutoff = 0.3f;
+  Texture t;
+  t.width = 1;
+  t.height = 1;
+  t.rgba = {1, 2, 3, 4};
+  Texture shared = t;
+  shared.rgba.clear();
+  shared.pixelSource = 0;
+  shared.uvRow0 = glm::vec3(2.0f, 0.0f, 0.5f);
+  s.textures = {t, shared};
+  s.materials = {plastic};
+  GpuScene g = packScene(s, buildBvh(s.triangles));
+  CHECK(g.features.ggx);  // a diffuse base with a specular layer is GGX
+  CHECK(g.features.textures);
+  CHECK(g.features.opacity);  // texture alpha (MASK)
+  const gpu::Material& m = g.materials[0];
+  CHECK(m.specular == glm::vec4(0.04f, 0.03f, 0.02f, 0.5f));
+  CHECK(m.tex2.x == 1u);
+  CHECK(m.tex2.y == 0u);
+  float scale, cutoff;
+  std::memcpy(&scale, &m.tex2.z, 4);
+  std::memcpy(&cutoff, &m.tex2.w, 4);
+  CHECK(scale == 0.25f);
+  CHECK(cutoff == 0.3f);
+  CHECK((m.tex.z & gpu::kMatAlphaTexture) != 0u);
+  CHECK((m.tex.z & gpu::kMatAlphaMask) != 0u);
+  REQUIRE(g.texInfo.size() == 2);
+  CHECK(g.texels.size() == 1);  // the transformed entry shares the texel
+  CHECK(g.texInfo[1].offset == g.texInfo[0].offset);
+  CHECK(g.texInfo[1].uvRow0 == glm::vec4(2.0f, 0.0f, 0.5f, 0.0f));
+  CHECK(g.texInfo[0].uvRow1 == glm::vec4(0.0f, 1.0f, 0.0f, 0.0f));
 }

@@ -25,6 +25,7 @@ Checkpoint sample(int w, int h, float base) {
   for (int i = 0; i < w * h * 4; ++i) {
     ck.state.accum.push_back(base + 0.25f * float(i));
     ck.state.comp.push_back(-1e-7f * float(i));
+    ck.state.half.push_back(0.5f * base + 0.125f * float(i));
   }
   ck.seed = 7;
   ck.sceneHash = 0x0123456789abcdefull;
@@ -68,7 +69,8 @@ TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
   CHECK(b.settingsText == a.settingsText);
   CHECK(b.state.accum == a.state.accum);
   CHECK(b.state.comp == a.state.comp);
-  CHECK(slurp(path).rfind("CAUSTICA-CKPT 1\n", 0) == 0);
+  CHECK(b.state.half == a.state.half);
+  CHECK(slurp(path).rfind("CAUSTICA-CKPT 2\n", 0) == 0);
   CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.settingsText).empty());
 }
 
@@ -84,6 +86,11 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   flipped[flipped.size() - 3] ^= 0x10;
   spit(path, flipped);
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
+  // A version-1 file (no half image: no error estimate to resume adaptive sampling from) is refused.
+  std::string v1 = good;
+  v1.replace(0, std::string("CAUSTICA-CKPT 2").size(), "CAUSTICA-CKPT 1");
+  spit(path, v1);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads version 2)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);

@@ -572,10 +572,16 @@ TEST_CASE("material contract: alpha modes, emission strength, glass extensions, 
               {"KHR_materials_dispersion", {{"dispersion", 0.5}}}}}});
   material({{"name", "rough mirror"}, {"pbrMetallicRoughness", {{"metallicFactor", 0.6}, {"roughnessFactor", 0.4}}}});
   material({{"name", "spec default"}});
+  material({{"name", "plastic"},
+            {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.3}}},
+            {"extensions",
+             {{"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {1.0, 0.5, 0.25}}}},
+              {"KHR_materials_ior", {{"ior", 2.0}}}}}});
   g.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
-                             "KHR_materials_volume", "KHR_materials_dispersion", "EXT_something_else"};
+                             "KHR_materials_volume", "KHR_materials_dispersion", "KHR_materials_specular",
+                             "EXT_something_else"};
   const Scene s = g.load(dir);
-  REQUIRE(s.materials.size() == 8);
+  REQUIRE(s.materials.size() == 9);
   CHECK(findMaterial(s, "opaque")->baseColor.a == 1.0f);
   CHECK(findMaterial(s, "opaque")->baseColor.b == doctest::Approx(0.6));
   CHECK(findMaterial(s, "blend")->baseColor.a == doctest::Approx(0.3));
@@ -600,18 +606,30 @@ TEST_CASE("material contract: alpha modes, emission strength, glass extensions, 
   CHECK(spec->roughness == 1.0f);
   CHECK(spec->ior == doctest::Approx(1.5));
   CHECK(std::isinf(spec->attenuationDistance));
-  CHECK(hasWarning(s, "'rough mirror'"));
-  CHECK(hasWarning(s, "'spec default'"));
+  // Roughness is rendered (GGX), so it is no longer warned about.
+  CHECK(!hasWarning(s, "'rough mirror'"));
+  CHECK(!hasWarning(s, "'spec default'"));
+  CHECK(findMaterial(s, "rough mirror")->roughness == doctest::Approx(0.4));
+  // The specular layer: glTF's F0 = ((ior - 1) / (ior + 1))^2 = 0.04 at ior 1.5 and F90 = 1 by default;
+  // KHR_materials_specular scales F0 by specularColorFactor x specularFactor and F90 by specularFactor.
+  CHECK(spec->specularF0.g == doctest::Approx(0.04));
+  CHECK(spec->specularF90 == 1.0f);
+  const auto* plastic = findMaterial(s, "plastic");
+  CHECK(plastic->specularF0.r == doctest::Approx(0.5 / 9.0));  // ((2 - 1) / (2 + 1))^2 = 1/9
+  CHECK(plastic->specularF0.g == doctest::Approx(0.25 / 9.0));
+  CHECK(plastic->specularF0.b == doctest::Approx(0.125 / 9.0));
+  CHECK(plastic->specularF90 == doctest::Approx(0.5));
+  CHECK(!hasWarning(s, "'plastic'"));
   CHECK(!hasWarning(s, "'tinted glass'"));
   CHECK(hasWarning(s, "EXT_something_else"));
   for (const auto& w : s.warnings) CHECK(w.rfind(s.path + ": ", 0) == 0);
 
   SUBCASE("a required unsupported extension is an error") {
-    g.doc["extensionsUsed"] = {"KHR_texture_transform"};
-    g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+    g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
     const std::string error = loadError(dir.write("transform.gltf", g.text()));
     CHECK(error.find("transform.gltf: ") != std::string::npos);
-    CHECK(error.find("KHR_texture_transform") != std::string::npos);
+    CHECK(error.find("KHR_draco_mesh_compression") != std::string::npos);
   }
 }
 
@@ -698,6 +716,46 @@ TEST_CASE("textures: external PNG and JPEG files, samplers, emissive texture") {
   CHECK(std::abs(int(emissive.rgba[2]) - 50) <= 3);
   CHECK(emissive.rgba[3] == 255);
   CHECK(emissive.repeatS);  // no sampler: REPEAT
+}
+
+TEST_CASE("textures: metallicRoughness, normal, MASK with texture alpha, KHR_texture_transform") {
+  TempDir dir;
+  const unsigned char png[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+  REQUIRE(stbi_write_png((dir.path / "tiny.png").string().c_str(), 2, 2, 4, png, 8));
+  Gltf g;
+  g.doc["images"] = {{{"uri", "tiny.png"}}};
+  g.doc["textures"] = {{{"source", 0}}};
+  const json transform = {{"KHR_texture_transform", {{"offset", {0.0, 1.0}}, {"rotation", 1.57079632679}, {"scale", {0.5, 0.5}}}}};
+  const int mat = g.add("materials", {{"pbrMetallicRoughness",
+                                       {{"baseColorTexture", {{"index", 0}}},
+                                        {"metallicRoughnessTexture", {{"index", 0}, {"extensions", transform}}}}},
+                                      {"normalTexture", {{"index", 0}, {"scale", 0.5}}},
+                                      {"alphaMode", "MASK"},
+                                      {"alphaCutoff", 0.4}});
+  g.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", mat}})}});
+  const Scene s = g.load(dir);
+  const caustica::Material& m = s.materials[0];
+  CHECK(m.baseColorTexture == m.normalTexture);  // the same glTF texture without a transform: one entry
+  CHECK(m.normalScale == 0.5f);
+  CHECK(m.alphaFromTexture);
+  CHECK(m.alphaCutoff == doctest::Approx(0.4));
+  CHECK(m.baseColor.a == 1.0f);  // the cutoff is applied per hit to factor x texture alpha
+  REQUIRE(m.metallicRoughnessTexture >= 0);
+  REQUIRE(s.textures.size() == 2);
+  const caustica::Texture& t = s.textures[std::size_t(m.metallicRoughnessTexture)];
+  CHECK(t.pixelSource == m.baseColorTexture);  // shares the texels
+  CHECK(t.rgba.empty());
+  // The extension's example: rotation pi/2, offset (0, 1), scale 0.5 maps (u, v) to the lower left
+  // quadrant: u' = 0.5 v, v' = 1 - 0.5 u.
+  const auto apply = [&](glm::vec2 uv) {
+    return glm::vec2(glm::dot(t.uvRow0, glm::vec3(uv, 1.0f)), glm::dot(t.uvRow1, glm::vec3(uv, 1.0f)));
+  };
+  CHECK(glm::length(apply({0, 0}) - glm::vec2(0.0f, 1.0f)) < 1e-6f);
+  CHECK(glm::length(apply({1, 0}) - glm::vec2(0.0f, 0.5f)) < 1e-6f);
+  CHECK(glm::length(apply({0, 1}) - glm::vec2(0.5f, 1.0f)) < 1e-6f);
+  for (const auto& w : s.warnings) CHECK(w.find("normalTexture") == std::string::npos);
 }
 
 TEST_CASE("external buffers: percent-encoded file names") {

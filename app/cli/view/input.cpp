@@ -34,6 +34,7 @@ const char* const kViewerControls =
     "  T                    tone curve: aces / clamp\n"
     "  space                pause / resume sampling (changes apply on resume)\n"
     "  P                    screenshot: caustica-SCENE-Nspp.png and .exr, at the end of the pass in flight\n"
+    "  G                    stop refining at the target relMSE (--target-error, default 0.01) on / off\n"
     "  H                    print these controls\n"
     "  Esc                  quit\n";
 
@@ -82,6 +83,7 @@ void applyKeys(GlfwWindow& window, CameraController& controller, ViewControls& c
         c.redraw = true;
         break;
       case GLFW_KEY_P: c.screenshotPending = true; break;
+      case GLFW_KEY_G: c.stopAtTarget = !c.stopAtTarget; break;
       case GLFW_KEY_H: std::cout << kViewerControls << std::flush; break;
       default: break;
     }

@@ -20,6 +20,8 @@ struct ViewControls {
   bool fly = false;                // left drag looks around instead of orbiting
   bool screenshotPending = false;  // P: write a screenshot pair at the end of the pass in flight
   bool redraw = true;              // the shown image is out of date (restart, exposure, damage...)
+  bool stopAtTarget = false;       // G: stop refining once the estimated relMSE reaches targetError
+  double targetError = 0.01;       // relMSE (--target-error; G toggles stopping there)
 };
 
 class ViewerInput {

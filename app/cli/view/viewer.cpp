@@ -4,10 +4,13 @@
 
 #ifdef CAUSTICA_HAVE_GLFW
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 
+#include "cli/environment_options.h"
+#include "gpu/adaptive_sampler.h"
 #include "image/image_io.h"
 #include "util/error.h"
 
@@ -39,6 +42,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   RenderSettings settings = renderSettingsFrom(opts, scene_.camera, kDefaultWidth);
   controls_.wanted = settings;
   controls_.tone = config_.tone;
+  controls_.stopAtTarget = config_.targetError > 0.0;
+  if (config_.targetError > 0.0) controls_.targetError = config_.targetError;
   input_ = ViewerInput(controls_, config_.spinRadians);
 
   std::string glInfo;
@@ -89,6 +94,8 @@ void Viewer::syncRenderer() {
   if (res.leftPreview) presenter_.keepPreview(*renderer_, controls_.tone);
   if (resizeRenderer(res.width, res.height)) restarted = true;
   if (restarted) {
+    estimate_ = std::numeric_limits<double>::infinity();
+    nextEstimate_ = 0;
     pacer_.restartPass();
     showPreviewCopy_ = res.leftPreview;
     controls_.redraw = true;
@@ -125,6 +132,7 @@ void Viewer::renderWithin(double budgetMs, bool stopAtPassEnd) {
     newSamples_ = true;
     if (passDone) {
       renderer_->endPass(band.spp);
+      estimateAfterPass();
       if (!pacer_.previewing()) {
         showPreviewCopy_ = false;
         if (controls_.screenshotPending) {
@@ -136,6 +144,17 @@ void Viewer::renderWithin(double budgetMs, bool stopAtPassEnd) {
     }
     if (!pacer_.nextRowFits(w, remainingMs())) break;
   }
+}
+
+// The error estimate reads three images back: only at the schedule of AdaptiveSampler (16 spp, then
+// each +1/8), whether or not a target is set, so the title can show it.
+void Viewer::estimateAfterPass() {
+  const int spp = renderer_->samplesPerPixel();
+  if (pacer_.previewing() || spp < nextEstimate_ || spp < 2) return;
+  if (nextEstimate_ == 0) nextEstimate_ = AdaptiveSampler(1.0, false).checkAtOrAfter(spp);
+  if (spp < nextEstimate_) return;
+  estimate_ = renderer_->errorEstimate().image;
+  nextEstimate_ = AdaptiveSampler(1.0, false).checkAtOrAfter(spp + 1);
 }
 
 // Showing the image costs GPU time too (tone mapping, blit): while the view is still, frames are shown
@@ -184,7 +203,8 @@ void Viewer::updateTitle(bool force) {
   }
   lastTitle_ = t;
   const RenderSettings& wanted = controls_.wanted;
-  std::string title = "caustica view - " + sceneName_ + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
+  std::string title = "caustica view - " + sceneName_ + " | " +
+                      lightingTag(scene_.scene, renderer_->gpuScene().emitters.size()) + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
                       format("%.3g samples/s", samplesPerSecond_) + " | " + format("%.1f ms/frame", frameMs_) + " | " +
                       integratorName(wanted.integrator) +
                       (wanted.integrator == Integrator::Mis && !renderer_->gpuScene().casters.empty()
@@ -193,6 +213,8 @@ void Viewer::updateTitle(bool force) {
                       " | " + dispersionModeName(wanted.dispersion) + " | depth " + std::to_string(wanted.maxDepth) +
                       " | " + format("exposure %+.1f", controls_.tone.exposureStops) + " | non-finite " +
                       std::to_string(renderer_->stats().nonFinite);
+  if (std::isfinite(estimate_)) title += format(" | relMSE~%.3g", estimate_);
+  if (controls_.stopAtTarget) title += format(" | target %.3g", controls_.targetError);
   if (pacer_.previewing()) title += " | preview 1/" + std::to_string(pacer_.previewScale());
   if (controls_.fly) title += " | fly";
   if (controls_.paused) title += " | paused";
@@ -255,10 +277,12 @@ int Viewer::run() {
   if (config_.frameLimit > 0 && !closed) finishPass();
   if (config_.frameLimit > 0) {
     updateTitle(true);
-    std::printf("%d frames in %.2f s (%.1f ms/frame), %d shown (%.1f fps), %.3g samples/s; %dx%d, %d spp\n", frames_,
+    std::printf("%d frames in %.2f s (%.1f ms/frame), %d shown (%.1f fps), %.3g samples/s; %dx%d, %d spp%s\n", frames_,
                 loopSeconds, 1000.0 * loopSeconds / std::max(frames_, 1), loopPresented,
                 loopPresented / std::max(loopSeconds, 1e-9), static_cast<double>(loopSamples) / std::max(loopSeconds, 1e-9),
-                renderer_->settings().width, renderer_->settings().height, renderer_->samplesPerPixel());
+                renderer_->settings().width, renderer_->settings().height, renderer_->samplesPerPixel(),
+                std::isfinite(estimate_) ? format(", relMSE~%.3g", estimate_).c_str() : "");
+    if (controls_.stopAtTarget && done()) std::printf("target relMSE %.3g reached\n", controls_.targetError);
   }
   if (!config_.screenshotPath.empty()) {
     writeImage(config_.screenshotPath, renderer_->image(), controls_.tone);

@@ -1,6 +1,7 @@
 // viewer.h — `caustica view`'s window: owns the window, renderer and camera controller and runs the
 // loop (input, path tracing in row bands within a GPU time budget, presentation, title, screenshots).
 #pragma once
+#include <limits>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -25,6 +26,7 @@ struct ViewConfig {
   std::string screenshotPath;  // written at exit ("" = none)
   double budgetMs = 30.0;      // path-tracing GPU time per frame, milliseconds
   int maxSpp = 0;              // stop refining here; 0 = never
+  double targetError = 0.0;    // --target-error: stop refining once the estimated relMSE is at most this; 0 = off
   bool vsync = true;
   bool preview = true;         // lower resolution while the camera moves, when full passes do not fit
   double spinRadians = 0.0;    // orbit per frame
@@ -51,7 +53,10 @@ class Viewer {
   void finishPass();
   void updateTitle(bool force);
   void writeScreenshotPair();
-  bool done() const { return pacer_.done(renderer_->samplesPerPixel()); }
+  bool done() const {
+    return pacer_.done(renderer_->samplesPerPixel()) || (controls_.stopAtTarget && estimate_ <= controls_.targetError);
+  }
+  void estimateAfterPass();  // the error estimate at scheduled sample counts (docs/adaptive-sampling.md)
 
   ViewConfig config_;
   Clock::time_point start_ = Clock::now();
@@ -74,6 +79,8 @@ class Viewer {
 
   // Statistics.
   std::uint64_t samples_ = 0;  // pixel samples traced since start
+  double estimate_ = std::numeric_limits<double>::infinity();  // estimated relMSE of the image (inf: none yet)
+  int nextEstimate_ = 0;       // spp of the next error estimate
   int frames_ = 0;             // loop iterations: input, at most one budget of path tracing, maybe a shown frame
   double lastInput_ = 0.0;     // seconds
   int presented_ = 0;          // frames shown

@@ -35,6 +35,12 @@ if(CAUSTICA_VIEWER)
                      -P ${CMAKE_CURRENT_LIST_DIR}/view_spin.cmake)
     set_tests_properties("viewer: spinning camera with preview"
                          PROPERTIES ENVIRONMENT "LP_NUM_THREADS=2" TIMEOUT 180 RESOURCE_LOCK xvfb)
+    # --target-error: refining (and GPU work) stops once the error estimate reaches the target.
+    add_test(NAME "viewer: --target-error stops refining at the target"
+             COMMAND ${CMAKE_COMMAND} -DXVFB_RUN=${XVFB_RUN} -DCLI=$<TARGET_FILE:caustica> -DDIR=${VIEWER_TEST_DIR}/target
+                     -P ${CMAKE_CURRENT_LIST_DIR}/view_target.cmake)
+    set_tests_properties("viewer: --target-error stops refining at the target"
+                         PROPERTIES ENVIRONMENT "LP_NUM_THREADS=2" TIMEOUT 180 RESOURCE_LOCK xvfb)
   else()
     message(STATUS "xvfb-run not found: the viewer's window tests are skipped (Debian: apt-get install xvfb xauth)")
   endif()

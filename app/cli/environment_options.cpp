@@ -1,0 +1,81 @@
+// environment_options.cpp — --env, --env-strength, --env-rotation, --background and the default
+// environment (docs/lighting.md).
+#include "cli/environment_options.h"
+
+#include "util/error.h"
+
+namespace caustica::cli {
+
+std::vector<OptionSpec> environmentOptionSpecs() {
+  return {
+      {"--env", "", "FILE|RGB|none",
+       "environment light: an equirectangular .hdr/.exr map, a uniform sky (0.8 or R,G,B) or none "
+       "(default: none if the scene has emitters, else a uniform sky of radiance 1)"},
+      {"--env-strength", "", "S", "multiplies the environment's radiance (default 1)"},
+      {"--env-rotation", "", "DEG", "turns the environment map about +Y, right-handed (default 0)"},
+      {"--background", "", "WHAT",
+       "what camera rays that leave the scene see: env (default) or a colour (0.2 or R,G,B)"},
+  };
+}
+
+namespace {
+// The raster and Whitted modes light with the emitters only (docs/render-modes.md): say so when
+// the environment is all the light there is.
+void noteModeWithoutEnvironment(const Options& opts, const Scene& scene, bool verbose) {
+  const std::string mode = opts.get("--mode", "path");
+  if (mode != "path" && scene.environment.emits())
+    note(!verbose, "warning: the image will be black: --mode " + mode + " does not see the environment yet and " +
+                       scene.path + " has no emitters (use --mode path)");
+}
+}  // namespace
+
+void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
+  const float strength = static_cast<float>(opts.getDouble("--env-strength", 1.0));
+  const float rotation = static_cast<float>(opts.getDouble("--env-rotation", 0.0));
+  if (!(strength >= 0.0f)) throw Error("option --env-strength needs a non-negative number");
+  scene.background = parseBackground(opts.get("--background", "env"));
+  scene.environment = Environment{};
+  const bool emitters = sceneHasLights(scene);  // emissive triangles (the environment is not set yet)
+  if (opts.has("--env")) {
+    scene.environment = parseEnvironment(opts.get("--env", "none"), strength, rotation);
+    if (!emitters && !scene.environment.emits())
+      note(!verbose, "warning: the image will be black: " + scene.path +
+                         " has no emitters (emissive triangles or punctual lights) and the environment emits nothing (--env " +
+                         opts.get("--env", "") + ")");
+    else if (!emitters)
+      noteModeWithoutEnvironment(opts, scene, verbose);
+    return;
+  }
+  if (emitters) return;
+  scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance), strength);
+  scene.environment.rotationDegrees = rotation;
+  scene.environment.isDefault = true;
+  note(!verbose, scene.path + " has no emitters (emissive triangles or punctual lights): lit by the default environment, a uniform sky of radiance 1 "
+                              "(--env FILE|RGB to choose one, --env none for none)");
+  noteModeWithoutEnvironment(opts, scene, verbose);
+}
+
+std::string lightingSummary(const Scene& scene, std::size_t emitterTriangles) {
+  std::string s = std::to_string(emitterTriangles) + " emitter triangle" + (emitterTriangles == 1 ? "" : "s") + ", " +
+                  std::to_string(scene.punctualLights.size()) + " punctual, environment " + scene.environment.describe();
+  if (scene.background.kind != Background::Kind::Environment) s += ", background " + scene.background.describe();
+  return s;
+}
+
+std::string lightingTag(const Scene& scene, std::size_t emitterTriangles) {
+  std::string s;
+  if (emitterTriangles > 0) s = std::to_string(emitterTriangles) + " emitter tris";
+  if (!scene.punctualLights.empty())
+    s += (s.empty() ? "" : " + ") + std::to_string(scene.punctualLights.size()) + " punctual";
+  const Environment& e = scene.environment;
+  if (e.emits()) {
+    std::string env = e.isDefault ? "env default (uniform 1)"
+                      : e.kind == Environment::Kind::Uniform
+                          ? "env uniform"
+                          : "env " + e.source.substr(e.source.find_last_of('/') + 1);
+    s += (s.empty() ? "" : " + ") + env;
+  }
+  return s.empty() ? "no lights" : s;
+}
+
+}  // namespace caustica::cli
