@@ -10,6 +10,7 @@
 #include "lib/traverse.glsl"
 #include "lib/camera.glsl"
 #include "lib/textures.glsl"
+#include "lib/microfacet.glsl"
 #include "lib/materials.glsl"
 #include "lib/point_lights.glsl"
 #include "lib/accumulate.glsl"
