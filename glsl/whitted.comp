@@ -10,6 +10,7 @@
 #include "lib/traverse.glsl"
 #include "lib/camera.glsl"
 #include "lib/textures.glsl"
+#include "lib/microfacet.glsl"
 #include "lib/materials.glsl"
 #include "lib/point_lights.glsl"
 #include "lib/accumulate.glsl"
@@ -167,7 +168,7 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
 #endif
     float diffuseWeight = alpha * (1.0 - metal) * (1.0 - trans);
     if (diffuseWeight > 0.0)
-      radiance += w * diffuseWeight * directLight(p, pError, ng, ns, -r.dir, base.rgb, m.params.y, r.sigma);
+      radiance += w * diffuseWeight * directLight(p, pError, ng, ns, -r.dir, base.rgb, phongRoughness(m), r.sigma);
     if (r.depth + 1u >= maxDepth) continue;
 #ifdef CAUSTICA_MIRROR
     if (metal > 0.0) {

@@ -200,7 +200,9 @@ void RasterRenderer::setMaterial(std::uint32_t material, bool planarMirror) cons
   const gpu::Material& m = materials_[material];
   glUniform4fv(kUBaseColor, 1, glm::value_ptr(m.baseColor));
   glUniform4f(kUEmission, m.emission.x, m.emission.y, m.emission.z, (m.tex.z & gpu::kMatDoubleSided) ? 1.0f : 0.0f);
-  glUniform4fv(kUParams, 1, glm::value_ptr(m.params));
+  glm::vec4 params = m.params;
+  if (!(m.specular.w > 0.0f)) params.y = 1.0f;  // no specular layer: no highlight (phongRoughness in point_lights.glsl)
+  glUniform4fv(kUParams, 1, glm::value_ptr(params));
   bool textured = m.tex.x != gpu::kInvalidIndex && m.tex.x < textures_.size();
   glUniform1i(kUHasTexture, textured ? 1 : 0);
   glActiveTexture(GL_TEXTURE0);

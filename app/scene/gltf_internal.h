@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -134,6 +135,7 @@ class SceneBuilder {
   // ---- materials (gltf_materials.cpp) ----
   double unit(double v, const std::string& what);
   Material convertMaterial(int index);
+  std::set<int> materialTexCoords_;  // UV sets the textures of the material being converted name
   int texture(const tinygltf::TextureInfo& info, const std::string& at);
   int texture(const tinygltf::NormalTextureInfo& info, const std::string& at);
   std::uint32_t defaultMaterial(const std::string& at);

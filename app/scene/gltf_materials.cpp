@@ -81,6 +81,7 @@ Material SceneBuilder::convertMaterial(int index) {
   const tinygltf::Material& m = model_.materials[std::size_t(index)];
   const std::string at = "materials[" + str(std::uint64_t(index)) + "]";
   Material out;
+  materialTexCoords_.clear();
   out.name = m.name.empty() ? "material " + str(std::uint64_t(index)) : m.name;
   const auto& pbr = m.pbrMetallicRoughness;
 
@@ -186,6 +187,15 @@ Material SceneBuilder::convertMaterial(int index) {
     else out.dispersion = float(dispersion);
   }
   if (!ignored.empty()) warn(at + " '" + oneLine(out.name) + "': ignoring unsupported " + ignored);
+  // Triangles carry one UV set, so a material's textures must agree on theirs (TEXCOORD_0 or _1).
+  if (materialTexCoords_.size() == 1 && (*materialTexCoords_.begin() == 0 || *materialTexCoords_.begin() == 1)) {
+    out.texCoord = *materialTexCoords_.begin();
+  } else if (!materialTexCoords_.empty()) {
+    std::string sets;
+    for (int t : materialTexCoords_) sets += (sets.empty() ? "TEXCOORD_" : ", TEXCOORD_") + str(std::uint64_t(std::max(t, 0)));
+    warn(at + " '" + oneLine(out.name) + "': its textures read " + sets +
+         "; caustica keeps one UV set per material (TEXCOORD_0 or TEXCOORD_1) and uses TEXCOORD_0 for all of them");
+  }
   return out;
 }
 
@@ -215,13 +225,11 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
     row1 = glm::dvec3(-s * scale.x, c * scale.y, offset.y);
     if (t->Has("texCoord") && t->Get("texCoord").IsInt()) texCoord = t->Get("texCoord").GetNumberAsInt();
   }
-  if (texCoord != 0)
-    warn(at + " uses TEXCOORD_" + str(std::uint64_t(std::max(texCoord, 0))) +
-         "; only TEXCOORD_0 is loaded and used instead");
+  materialTexCoords_.insert(texCoord);  // one UV set per material: chosen in convertMaterial
   if (row0 != glm::dvec3(1.0, 0.0, 0.0) || row1 != glm::dvec3(0.0, 1.0, 0.0)) {
     tinygltf::TextureInfo plain = info;
     plain.extensions.clear();
-    plain.texCoord = 0;
+    plain.texCoord = texCoord;
     const int base = texture(plain, at);
     if (base < 0) return -1;
     const std::vector<float> key = {float(row0.x), float(row0.y), float(row0.z), float(row1.x), float(row1.y), float(row1.z)};

@@ -304,14 +304,6 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
   const std::vector<double> normals = readAttribute(
       prim, "NORMAL", TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, vertexCount, at);
-  const std::vector<double> uvs =
-      readAttribute(prim, "TEXCOORD_0", TINYGLTF_TYPE_VEC2,
-                    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false},
-                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
-                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
-                    vertexCount, at);
-  for (std::size_t i = 0; i < uvs.size(); ++i)
-    if (!std::isfinite(uvs[i])) fail(at + ": TEXCOORD_0 of vertex " + str(i / 2) + " is not finite");
 
   std::vector<std::uint32_t> indices;
   if (prim.indices >= 0) {
@@ -342,6 +334,19 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
   } else {
     material = defaultMaterial(at);
   }
+  // The UV set the material's textures read (TEXCOORD_0 unless they all name TEXCOORD_1).
+  const std::string uvName = scene_.materials[material].texCoord == 1 && prim.attributes.count("TEXCOORD_1")
+                                 ? "TEXCOORD_1" : "TEXCOORD_0";
+  if (scene_.materials[material].texCoord == 1 && uvName != "TEXCOORD_1")
+    warn(at + ": its material's textures read TEXCOORD_1, which the primitive lacks; TEXCOORD_0 is used");
+  const std::vector<double> uvs =
+      readAttribute(prim, uvName.c_str(), TINYGLTF_TYPE_VEC2,
+                    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false},
+                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
+                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
+                    vertexCount, at);
+  for (std::size_t i = 0; i < uvs.size(); ++i)
+    if (!std::isfinite(uvs[i])) fail(at + ": " + uvName + " of vertex " + str(i / 2) + " is not finite");
 
   // Corner triples in glTF's counter-clockwise order for each mode (glTF 3.7.2.1).
   const std::size_t n = indices.size();

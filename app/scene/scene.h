@@ -45,6 +45,7 @@ struct Material {
   // F90 = specularFactor; F90 = 0 (the default of this struct) means a purely Lambertian base.
   glm::vec3 specularF0{0.0f};
   float specularF90 = 0.0f;
+  int texCoord = 0;                   // the UV set (TEXCOORD_0 or TEXCOORD_1) every texture of the material reads
   bool alphaFromTexture = false;      // BLEND or MASK with a base-colour texture: its alpha multiplies baseColor.a
   float alphaCutoff = -1.0f;          // alphaMode MASK: opaque where alpha >= cutoff, else absent; < 0: not MASK
   float transmission = 0.0f;          // KHR_materials_transmission: dielectric weight in [0,1]
@@ -64,7 +65,7 @@ struct Material {
 struct Triangle {
   glm::vec3 p[3];
   glm::vec3 n[3];   // unit shading normals (flat normals when the mesh has none)
-  glm::vec2 uv[3];  // TEXCOORD_0, (0,0) when absent
+  glm::vec2 uv[3];  // the material's UV set (TEXCOORD_0 or TEXCOORD_1, Material::texCoord), (0,0) when absent
   std::uint32_t material = 0;
 };
 

@@ -11,6 +11,10 @@ vec3 pointLightIntensity(PointLight l, vec3 w) {
   return l.intensity.rgb * (max(0.0, dot(l.axis.xyz, w)) + l.position.w);
 }
 
+// The roughness that sets a material's Phong highlight: its own where it has a specular layer (glTF
+// dielectrics, Material.specular.w = F90 > 0), else 1 (no highlight: a purely Lambertian base).
+float phongRoughness(Material m) { return m.specular.w > 0.0 ? m.params.y : 1.0; }
+
 // Phong BRDF of a material at a diffuse vertex (per steradian): Lambert base / pi plus a normalised
 // Blinn-Phong highlight (Fresnel 0.04 of a dielectric) whose exponent follows the roughness; rough 1: none.
 vec3 phongBrdf(vec3 base, float roughness, vec3 n, vec3 wl, vec3 wv) {

@@ -758,6 +758,41 @@ TEST_CASE("textures: metallicRoughness, normal, MASK with texture alpha, KHR_tex
   for (const auto& w : s.warnings) CHECK(w.find("normalTexture") == std::string::npos);
 }
 
+TEST_CASE("textures: a material whose textures all name TEXCOORD_1 reads that set; mixed sets fall back to TEXCOORD_0") {
+  TempDir dir;
+  const unsigned char png[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+  REQUIRE(stbi_write_png((dir.path / "tiny.png").string().c_str(), 2, 2, 4, png, 8));
+  Gltf g;
+  g.doc["images"] = {{{"uri", "tiny.png"}}};
+  g.doc["textures"] = {{{"source", 0}}};
+  const int uv0 = g.accessor(std::vector<float>{0.1f, 0.1f, 0.2f, 0.1f, 0.1f, 0.2f}, kFloat, "VEC2");
+  const int uv1 = g.accessor(std::vector<float>{0.7f, 0.7f, 0.9f, 0.7f, 0.7f, 0.9f}, kFloat, "VEC2");
+  const int set1 = g.add("materials", {{"name", "set1"},
+                                       {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}},
+                                       {"normalTexture", {{"index", 0}, {"texCoord", 1}}}});
+  const int mixed = g.add("materials", {{"name", "mixed"},
+                                        {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}},
+                                        {"emissiveTexture", {{"index", 0}}}});
+  const int pos = g.positions(kTriangle);
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}}, {"material", set1}})}});
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}}, {"material", mixed}})}});
+  g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}}}, {"material", set1}})}});
+  const Scene s = g.load(dir);
+  REQUIRE(s.triangles.size() == 3);
+  CHECK(findMaterial(s, "set1")->texCoord == 1);
+  CHECK(findMaterial(s, "mixed")->texCoord == 0);
+  CHECK(hasWarning(s, "TEXCOORD_0, TEXCOORD_1"));
+  CHECK(hasWarning(s, "which the primitive lacks"));
+  for (const caustica::Triangle& t : s.triangles) {
+    const bool readsSet1 = s.materials[t.material].name == "set1" && t.uv[1].x > 0.5f;
+    const glm::vec2 expect = readsSet1 ? glm::vec2(0.9f, 0.7f) : glm::vec2(0.2f, 0.1f);
+    CHECK(glm::length(t.uv[1] - expect) < 1e-6f);
+  }
+  int set1Triangles = 0;
+  for (const caustica::Triangle& t : s.triangles) set1Triangles += t.uv[0].x > 0.5f;
+  CHECK(set1Triangles == 1);  // only the primitive that has TEXCOORD_1
+}
+
 TEST_CASE("external buffers: percent-encoded file names") {
   TempDir dir;
   Gltf g;

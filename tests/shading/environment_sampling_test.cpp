@@ -1,5 +1,6 @@
 // environment_sampling_test.cpp — the environment map's convention, its importance sampler against its
 // pdf (chi-square), and reading .hdr maps (C++ twin of glsl/lib/environment.glsl; no GL).
+#include "chi_square.h"
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -15,34 +16,10 @@
 #include "util/error.h"
 
 using namespace caustica;
+using caustica::test::chiSquare;
+using caustica::test::chiSquareLimit;
 
 namespace {
-
-// Pearson chi-square over bins with expectation >= 5 (the rest merged into one bin).
-double chiSquare(const std::vector<double>& observed, const std::vector<double>& expected, int& dof) {
-  double chi = 0, restO = 0, restE = 0;
-  dof = -1;
-  for (size_t i = 0; i < observed.size(); ++i) {
-    if (expected[i] < 5.0) {
-      restO += observed[i];
-      restE += expected[i];
-      continue;
-    }
-    chi += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++dof;
-  }
-  if (restE >= 5.0) {
-    chi += (restO - restE) * (restO - restE) / restE;
-    ++dof;
-  }
-  return chi;
-}
-// Upper bound of the chi-square distribution at a very small significance (Wilson–Hilferty, z = 4.5).
-double chiSquareLimit(int dof) {
-  double k = dof, z = 4.5;
-  double t = 1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k));
-  return k * t * t * t;
-}
 
 // A w x h map: a sky gradient (brighter towards +Y, bluish), black below the horizon except a
 // dim ground, and a 2x2-texel sun of radiance `sun` at texel (sx, sy).

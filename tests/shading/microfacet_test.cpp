@@ -1,6 +1,7 @@
 // microfacet_test.cpp — the GGX lobes' C++ twins (shading/microfacet.h): normalisation of D, chi-square
 // tests of every sampler against its pdf, reciprocity, and the directional albedo (the white furnace
 // of a rough metal with F0 = 1) against an independent numerical integration.
+#include "chi_square.h"
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -13,33 +14,10 @@
 #include "util/math_constants.h"
 
 using namespace caustica;
+using caustica::test::chiSquare;
+using caustica::test::chiSquareLimit;
 
 namespace {
-
-double chiSquare(const std::vector<double>& observed, const std::vector<double>& expected, int& dof) {
-  double chi = 0, restO = 0, restE = 0;
-  dof = -1;
-  for (size_t i = 0; i < observed.size(); ++i) {
-    if (expected[i] < 5.0) {
-      restO += observed[i];
-      restE += expected[i];
-      continue;
-    }
-    chi += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++dof;
-  }
-  if (restE >= 5.0) {
-    chi += (restO - restE) * (restO - restE) / restE;
-    ++dof;
-  }
-  return chi;
-}
-
-double chiSquareLimit(int dof) {  // Wilson–Hilferty, z = 4.5 (a false alarm about once in 300,000 runs)
-  double k = dof, z = 4.5;
-  double t = 1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k));
-  return k * t * t * t;
-}
 
 glm::vec3 dirFromCosPhi(double c, double phi) {
   double s = std::sqrt(std::max(0.0, 1.0 - c * c));

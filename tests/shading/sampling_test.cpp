@@ -1,4 +1,5 @@
 // sampling_test.cpp — chi-square and moment tests of the C++ twins of the shader sampling routines.
+#include "chi_square.h"
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -8,35 +9,10 @@
 #include "shading/sampling.h"
 
 using namespace caustica;
+using caustica::test::chiSquare;
+using caustica::test::chiSquareLimit;
 
 namespace {
-
-// Pearson chi-square statistic; bins with tiny expectations are merged into one.
-double chiSquare(const std::vector<double>& observed, const std::vector<double>& expected, int& dof) {
-  double chi = 0, restO = 0, restE = 0;
-  dof = -1;
-  for (size_t i = 0; i < observed.size(); ++i) {
-    if (expected[i] < 5.0) {
-      restO += observed[i];
-      restE += expected[i];
-      continue;
-    }
-    chi += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++dof;
-  }
-  if (restE >= 5.0) {
-    chi += (restO - restE) * (restO - restE) / restE;
-    ++dof;
-  }
-  return chi;
-}
-
-// Upper bound of the chi-square distribution at a very small significance (Wilson–Hilferty, z = 4.5).
-double chiSquareLimit(int dof) {
-  double k = dof, z = 4.5;
-  double t = 1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k));
-  return k * t * t * t;
-}
 
 }  // namespace
 
