@@ -86,6 +86,7 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
   float lambda = 0.0;      // nm; 0 while the path still carries every wavelength
   float prevPdf = 0.0;     // solid-angle pdf of the last BSDF sample (non-delta lobes)
   bool prevDelta = true;   // last direction came from the camera or a delta lobe: no MIS on emitter hits
+  vec3 prevP = vec3(0.0), prevN = vec3(0.0);  // last vertex's point and shading normal (light-tree pdf for MIS)
   vec3 sigma = vec3(0.0);  // absorption coefficient of the medium the ray travels in (per scene unit)
   uint maxDepth = frame.options.x;
   bool firstDiffuse = true;  // no diffuse vertex yet on this path
@@ -134,7 +135,7 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #endif
 #ifdef CAUSTICA_MIS
       if (!prevDelta) {
-        float pdfLight = lightPdfArea(m) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
+        float pdfLight = lightPdfArea(hit.tri, prevP, prevN) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
         w *= powerHeuristic(prevPdf, pdfLight);
       }
 #endif
@@ -295,6 +296,8 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     }
     dir = newDir;
     org = offsetRayOrigin(p, pError, dot(dir, ng) > 0.0 ? ng : -ng);
+    prevP = p;
+    prevN = ns;
   }
   return radiance;
 }

@@ -213,6 +213,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   std::vector<double> weights;
   std::vector<std::uint32_t> tris;
   double totalWeight = 0.0;
+  std::vector<LightTreeItem> lightItems;
   for (size_t i = 0; i < g.triGeom.size(); ++i) {
     const Material& m = scene.materials[scene.triangles[bvh.order[i]].material];
     if (!m.isEmissive()) continue;
@@ -223,7 +224,20 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
     weights.push_back(w);
     tris.push_back(static_cast<std::uint32_t>(i));
     totalWeight += w;
+    LightTreeItem item;
+    item.tri = static_cast<std::uint32_t>(i);
+    item.v[0] = glm::vec3(t.v0);
+    item.v[1] = glm::vec3(t.v1);
+    item.v[2] = glm::vec3(t.v2);
+    item.power = w;
+    item.twoSided = m.doubleSided;
+    lightItems.push_back(item);
   }
+  // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
+  // TriShade.vt.w (leaf index + 1 as uint bits, 0: not in the tree).
+  g.lightTree = buildLightTree(std::move(lightItems), g.triGeom.size());
+  for (size_t i = 0; i < g.triShade.size(); ++i)
+    g.triShade[i].vt.w = glm::uintBitsToFloat(g.lightTree.leafOf[i] == gpu::kInvalidIndex ? 0u : g.lightTree.leafOf[i] + 1u);
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
   g.emitters = buildAliasTable(weights, tris);

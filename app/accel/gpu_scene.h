@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/light_tree.h"
 #include "scene/caustic_casters.h"
 #include "scene/scene.h"
 #include "shading/environment_sampling.h"
@@ -32,7 +33,8 @@ struct GpuScene {
   std::vector<gpu::TriGeom> triGeom;    // BVH leaf order
   std::vector<gpu::TriShade> triShade;  // BVH leaf order
   std::vector<gpu::Material> materials;
-  std::vector<gpu::Emitter> emitters;   // alias table, one slot per emissive triangle
+  std::vector<gpu::Emitter> emitters;   // alias table, one slot per emissive triangle (host only: counts, info)
+  LightTree lightTree;                  // light tree over the same triangles: what the shaders sample (binding 4)
   std::vector<std::uint32_t> texels;    // RGBA8 packed as unpackUnorm4x8 reads them
   std::vector<gpu::TexInfo> texInfo;
   float totalEmitterWeight = 0.0f;      // sum of luminance(emission) * area * sides

@@ -82,7 +82,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   checkStorageSize(limits_, scene.path, "BVH nodes", g.nodes.size() * sizeof(gpu::BvhNode));
   checkStorageSize(limits_, scene.path, "triangles", g.triShade.size() * sizeof(gpu::TriShade));
   checkStorageSize(limits_, scene.path, "materials", g.materials.size() * sizeof(gpu::Material));
-  checkStorageSize(limits_, scene.path, "emitters", g.emitters.size() * sizeof(gpu::Emitter));
+  checkStorageSize(limits_, scene.path, "light tree", g.lightTree.nodes.size() * sizeof(gpu::LightNode));
   checkStorageSize(limits_, scene.path, "textures", g.texels.size() * 4);
 
   buffers_.resize(CAUSTICA_SSBO_COUNT);
@@ -90,7 +90,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   buffers_[CAUSTICA_BINDING_TRIGEOM] = GlBuffer::fromVector(g.triGeom);
   buffers_[CAUSTICA_BINDING_TRISHADE] = GlBuffer::fromVector(g.triShade);
   buffers_[CAUSTICA_BINDING_MATERIALS] = GlBuffer::fromVector(g.materials);
-  buffers_[CAUSTICA_BINDING_EMITTERS] = GlBuffer::fromVector(g.emitters);
+  buffers_[CAUSTICA_BINDING_EMITTERS] = GlBuffer::fromVector(g.lightTree.nodes);
   buffers_[CAUSTICA_BINDING_TEXELS] = GlBuffer::fromVector(g.texels);
   buffers_[CAUSTICA_BINDING_TEXINFO] = GlBuffer::fromVector(g.texInfo);
   buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);

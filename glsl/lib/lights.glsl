@@ -1,5 +1,6 @@
-// lights.glsl — next-event estimation: emissive triangles chosen in proportion to power through an
-// alias table (Emitter[] in gpu_layout.h), then a uniform point on the chosen triangle.
+// lights.glsl — next-event estimation: an emissive triangle chosen by its importance to the shading
+// point through the light tree (light_tree.glsl), then a uniform point on the chosen triangle.
+#include "light_tree.glsl"
 
 struct LightSample {
   vec3 p;        // world-space point on the emitter
@@ -11,19 +12,24 @@ struct LightSample {
   uint material;  // the emitter's material index
 };
 
-// Selection probability per unit area of emitter triangle material m: power weight / total, divided
-// by area. Matches the host's weight luminance(emission) * area * sides exactly.
-float lightPdfArea(Material m) {
-  float sides = (m.tex.z & kMatDoubleSided) != 0u ? 2.0 : 1.0;
-  return luminance(m.emission.rgb) * sides / frame.lights.x;
+// Probability per unit area that sampleLight(p, n, ...) picks a point on emissive triangle `tri` (TriGeom
+// order): the tree's choice probability from p (normal n) over the triangle's area. 0 for a triangle
+// outside the tree. p, n: the shading point and normal that light sampling used there.
+float lightPdfArea(uint tri, vec3 p, vec3 n) {
+  uint leaf = floatBitsToUint(triShade[tri].vt.w);  // leaf index + 1; 0: not in the tree
+  if (leaf == 0u) return 0.0;
+  TriGeom g = triGeom[tri];
+  float area = 0.5 * length(cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz));
+  return area > 0.0 ? lightTreePdf(p, n, leaf - 1u) / area : 0.0;
 }
 
-bool sampleLight(float uSlot, float uAlias, vec2 uTri, out LightSample ls) {
-  uint count = frame.options.z;
-  if (count == 0u) return false;
-  uint slot = min(uint(uSlot * float(count)), count - 1u);
-  Emitter e = emitters[slot];
-  uint tri = uAlias < e.prob ? e.tri : emitters[e.alias].tri;
+// Samples a point on an emitter for shading point p with unit normal n (world space): uSelect descends
+// the light tree, uTri places the point uniformly on the chosen triangle.
+bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
+  if (frame.options.z == 0u) return false;
+  uint tri;
+  float pmf;
+  if (!sampleLightTree(p, n, uSelect, tri, pmf)) return false;
   TriGeom g = triGeom[tri];
   vec2 b = sampleTriangleUniform(uTri);
   ls.p = (1.0 - b.x - b.y) * g.v0.xyz + b.x * g.v1.xyz + b.y * g.v2.xyz;
@@ -40,7 +46,7 @@ bool sampleLight(float uSlot, float uAlias, vec2 uTri, out LightSample ls) {
   uv = (1.0 - b.x - b.y) * vec2(s.n0.w, s.vt.x) + b.x * vec2(s.n1.w, s.vt.y) + b.y * vec2(s.n2.w, s.vt.z);
 #endif
   ls.le = materialEmission(m, uv);
-  ls.pdfArea = lightPdfArea(m);
+  ls.pdfArea = pmf / (0.5 * len);
   ls.twoSided = (m.tex.z & kMatDoubleSided) != 0u;
   return ls.pdfArea > 0.0;
 }

@@ -56,7 +56,7 @@ float vertexPdf(Vertex v, vec3 w) {
 // throughput); adds 1 to shadowRays for each visibility ray traced.
 vec3 sampleEmitterLight(Vertex v, inout uvec4 rng, inout uint shadowRays) {
   LightSample ls;
-  if (!sampleLight(rand01(rng), rand01(rng), rand2(rng), ls)) return vec3(0.0);
+  if (!sampleLight(v.p, v.ns, rand01(rng), rand2(rng), ls)) return vec3(0.0);
   vec3 toLight = ls.p - v.p;
   float dist2 = dot(toLight, toLight);
   float dist = sqrt(dist2);

@@ -22,7 +22,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_BINDING_TRIGEOM 1    // SSBO: TriGeom[] (reordered to BVH leaf order)
 #define CAUSTICA_BINDING_TRISHADE 2   // SSBO: TriShade[] (same order as TriGeom)
 #define CAUSTICA_BINDING_MATERIALS 3  // SSBO: Material[]
-#define CAUSTICA_BINDING_EMITTERS 4   // SSBO: Emitter[] (alias table over emissive triangles)
+#define CAUSTICA_BINDING_EMITTERS 4   // SSBO: LightNode[] (light tree over emissive triangles)
 #define CAUSTICA_BINDING_TEXELS 5     // SSBO: uint[] RGBA8 texels of all textures, sRGB-encoded
 #define CAUSTICA_BINDING_TEXINFO 6    // SSBO: TexInfo[]
 #define CAUSTICA_BINDING_COUNTERS 7   // SSBO: Counters (atomic statistics)
@@ -90,7 +90,7 @@ struct TriShade {
   vec4 n0;  // xyz: vertex normal 0 (world space, unit); w: u of texcoord 0
   vec4 n1;  // xyz: vertex normal 1; w: u of texcoord 1
   vec4 n2;  // xyz: vertex normal 2; w: u of texcoord 2
-  vec4 vt;  // x,y,z: v of texcoords 0,1,2; w unused
+  vec4 vt;  // x,y,z: v of texcoords 0,1,2; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0
 };
 
 // Material after the glTF material contract (docs/materials.md), 112 bytes.
@@ -130,6 +130,21 @@ struct Counters {
   uint secondaryRays;  // bounce rays traced
   uint shadowRays;     // next-event-estimation visibility rays traced
 };
+
+// One node of the light tree over the emissive triangles (64 bytes; app/accel/light_tree.h,
+// glsl/lib/light_tree.glsl): a binary BVH whose nodes bound the position, power and emission
+// directions of their triangles (Conty Estevez & Kulla 2018). Node 0 is the root; one triangle per leaf.
+// (Emitter above is the former alias-table slot, unused since the light tree.)
+struct LightNode {
+  vec4 boundsMin;  // xyz: world-space AABB minimum; w: power (sum of luminance(emission) * area * sides)
+  vec4 boundsMax;  // xyz: world-space AABB maximum; w: cos(theta_o), the normal cone's half angle
+  vec4 axis;       // xyz: unit axis of the normal cone; w: cos(theta_e), emission spread beyond the normals (0: cosine)
+  uvec4 link;      // x: inner: left child (right = x + 1); leaf: triangle (TriGeom order); y: kLightNode* flags;
+                   // z: leaf: bit trail from the root (bit d set: right child at depth d); w: leaf: depth
+};
+CAUSTICA_CONST uint kLightNodeLeaf = 1u;       // LightNode.link.y: a leaf (one triangle)
+CAUSTICA_CONST uint kLightNodeTwoSided = 2u;   // LightNode.link.y: some triangle below emits from both faces
+#define CAUSTICA_LIGHT_TREE_DEPTH 32           // bits of the trail: the builder keeps every leaf's depth <= this
 
 // ---- UBO ---------------------------------------------------------------------------------------
 // Per-dispatch parameters (std140: vec4/uvec4 only).
@@ -212,6 +227,7 @@ static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
 static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
+static_assert(sizeof(LightNode) == 64, "LightNode must be 64 bytes (std430)");
 }  // namespace caustica::gpu
 #endif
 #undef CAUSTICA_CONST

@@ -1,0 +1,103 @@
+// light_tree.glsl — chooses an emissive triangle by its importance to a shading point, descending the
+// light tree (LightNode[] in gpu_layout.h, built by app/accel/light_tree.cpp), and gives the
+// probability of any triangle's choice for MIS. C++ twins of the same names in app/accel/light_tree.h.
+// Needs `lightNodes[]` (bindings.glsl, or a test shader's own buffer).
+
+float ltCosSubClamped(float sinA, float cosA, float sinB, float cosB) {  // cos(max(0, a - b))
+  if (cosA > cosB) return 1.0;
+  return cosA * cosB + sinA * sinB;
+}
+float ltSinSubClamped(float sinA, float cosA, float sinB, float cosB) {  // sin(max(0, a - b))
+  if (cosA > cosB) return 0.0;
+  return sinA * cosB - cosA * sinB;
+}
+float ltSafeSqrt(float x) { return sqrt(max(x, 0.0)); }
+
+// An upper bound, up to a constant, of the light the node's triangles can send to p (world space) on a
+// surface with unit normal n (either side; n = 0: none): power x bounded emission cosine x bounded
+// receiver cosine / clamped squared distance; 0 where no triangle below can light p.
+float lightImportance(LightNode node, vec3 p, vec3 n) {
+  float power = node.boundsMin.w;
+  if (!(power > 0.0)) return 0.0;
+  vec3 lo = node.boundsMin.xyz, hi = node.boundsMax.xyz;
+  vec3 centre = 0.5 * (lo + hi);
+  vec3 d = p - centre;  // from the node's centre to p
+  float d2 = dot(d, d);
+  vec3 diag = hi - lo;
+  float r2 = 0.25 * dot(diag, diag);  // squared radius of the sphere around the box
+  float invD = d2 > 0.0 ? 1.0 / sqrt(d2) : 0.0;
+  float cosW = dot(node.axis.xyz, d) * invD;
+  if ((node.link.y & kLightNodeTwoSided) != 0u) cosW = abs(cosW);
+  float sinW = ltSafeSqrt(1.0 - cosW * cosW);
+  float cosB = d2 > r2 ? ltSafeSqrt(1.0 - r2 / d2) : -1.0;  // -1: p inside the sphere, every direction
+  float sinB = ltSafeSqrt(1.0 - cosB * cosB);
+  float cosO = node.boundsMax.w;
+  float sinO = ltSafeSqrt(1.0 - cosO * cosO);
+  float cosX = ltCosSubClamped(sinW, cosW, sinO, cosO);
+  float sinX = ltSinSubClamped(sinW, cosW, sinO, cosO);
+  float cosP = ltCosSubClamped(sinX, cosX, sinB, cosB);
+  if (cosP <= node.axis.w) return 0.0;
+  float importance = power * cosP / max(d2, r2);
+  if (dot(n, n) > 0.0) {  // the receiver's cosine, bounded the same way (either side of the surface)
+    float cosI = d2 > 0.0 ? abs(dot(d, n)) * invD : 1.0;
+    float sinI = ltSafeSqrt(1.0 - cosI * cosI);
+    importance *= ltCosSubClamped(sinI, cosI, sinB, cosB);
+  }
+  return max(importance, 0.0);
+}
+
+// Descends from the root choosing each child in proportion to its importance, u in [0, 1) rescaled at
+// every level. False where no triangle can light p; else tri (TriGeom order) and pmf, its probability.
+bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
+  pmf = 0.0;
+  tri = 0u;
+  uint i = 0u;
+  float prob = 1.0;
+  if ((lightNodes[0].link.y & kLightNodeLeaf) != 0u && !(lightImportance(lightNodes[0], p, n) > 0.0)) return false;
+  for (int depth = 0; depth <= CAUSTICA_LIGHT_TREE_DEPTH; ++depth) {
+    uvec4 link = lightNodes[i].link;
+    if ((link.y & kLightNodeLeaf) != 0u) {
+      tri = link.x;
+      pmf = prob;
+      return true;
+    }
+    float il = lightImportance(lightNodes[link.x], p, n);
+    float ir = lightImportance(lightNodes[link.x + 1u], p, n);
+    if (!(il + ir > 0.0)) return false;
+    float pl = il / (il + ir);
+    if (u < pl) {
+      u = min(u / pl, 0.99999994);
+      prob *= pl;
+      i = link.x;
+    } else {
+      u = min((u - pl) / (1.0 - pl), 0.99999994);
+      prob *= 1.0 - pl;
+      i = link.x + 1u;
+    }
+  }
+  return false;
+}
+
+// The probability that sampleLightTree(p, n) chooses the triangle of leaf node `leaf`: the same choices
+// repeated along the leaf's bit trail.
+float lightTreePdf(vec3 p, vec3 n, uint leaf) {
+  uint trail = lightNodes[leaf].link.z, depth = lightNodes[leaf].link.w;
+  if (depth == 0u) return lightImportance(lightNodes[0], p, n) > 0.0 ? 1.0 : 0.0;
+  uint i = 0u;
+  float prob = 1.0;
+  for (uint k = 0u; k < depth; ++k) {
+    uint left = lightNodes[i].link.x;
+    float il = lightImportance(lightNodes[left], p, n);
+    float ir = lightImportance(lightNodes[left + 1u], p, n);
+    if (!(il + ir > 0.0)) return 0.0;
+    float pl = il / (il + ir);
+    if (((trail >> k) & 1u) != 0u) {
+      prob *= 1.0 - pl;
+      i = left + 1u;
+    } else {
+      prob *= pl;
+      i = left;
+    }
+  }
+  return prob;
+}
