@@ -78,7 +78,7 @@ void GlBuffer::read(std::size_t offset, std::size_t bytes, void* out) const {
 
 void GlBuffer::bindBase(GLenum target, GLuint index) const { glBindBufferBase(target, index, id()); }
 
-GlTexture GlTexture::create2D(int width, int height, GLenum internalFormat) {
+GlTexture GlTexture::generate(int width, int height, GLenum internalFormat) {
   GlTexture t;
   GLuint id = 0;
   glGenTextures(1, &id);
@@ -86,6 +86,12 @@ GlTexture GlTexture::create2D(int width, int height, GLenum internalFormat) {
   t.width_ = width;
   t.height_ = height;
   t.format_ = internalFormat;
+  return t;
+}
+
+GlTexture GlTexture::create2D(int width, int height, GLenum internalFormat) {
+  GlTexture t = generate(width, height, internalFormat);
+  const GLuint id = t.id();
   glBindTexture(GL_TEXTURE_2D, id);
   glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, width, height);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -231,13 +237,8 @@ GlProgram GlProgram::compileGraphics(const std::string& vertexSource,
 }
 
 GlTexture GlTexture::createSrgb8(int width, int height, const void* rgba8, GLenum wrapS, GLenum wrapT, bool nearest) {
-  GlTexture t;
-  GLuint id = 0;
-  glGenTextures(1, &id);
-  t.handle_ = GlHandle(id, deleteTexture);
-  t.width_ = width;
-  t.height_ = height;
-  t.format_ = GL_SRGB8_ALPHA8;
+  GlTexture t = generate(width, height, GL_SRGB8_ALPHA8);
+  const GLuint id = t.id();
   int levels = 1;
   while ((std::max(width, height) >> levels) > 0) ++levels;
   glBindTexture(GL_TEXTURE_2D, id);
@@ -255,13 +256,8 @@ GlTexture GlTexture::createSrgb8(int width, int height, const void* rgba8, GLenu
 }
 
 GlTexture GlTexture::createDepthStencil(int width, int height) {
-  GlTexture t;
-  GLuint id = 0;
-  glGenTextures(1, &id);
-  t.handle_ = GlHandle(id, deleteTexture);
-  t.width_ = width;
-  t.height_ = height;
-  t.format_ = GL_DEPTH24_STENCIL8;
+  GlTexture t = generate(width, height, GL_DEPTH24_STENCIL8);
+  const GLuint id = t.id();
   glBindTexture(GL_TEXTURE_2D, id);
   glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH24_STENCIL8, width, height);
   glBindTexture(GL_TEXTURE_2D, 0);
@@ -270,13 +266,8 @@ GlTexture GlTexture::createDepthStencil(int width, int height) {
 }
 
 GlTexture GlTexture::createDepthCubeArray(int size, int cubes) {
-  GlTexture t;
-  GLuint id = 0;
-  glGenTextures(1, &id);
-  t.handle_ = GlHandle(id, deleteTexture);
-  t.width_ = size;
-  t.height_ = size;
-  t.format_ = GL_DEPTH_COMPONENT32F;
+  GlTexture t = generate(size, size, GL_DEPTH_COMPONENT32F);
+  const GLuint id = t.id();
   glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, id);
   glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_DEPTH_COMPONENT32F, size, size, 6 * std::max(cubes, 1));
   glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);

@@ -87,6 +87,8 @@ class GlTexture {
   GLuint id() const { return handle_.id(); }
 
  private:
+  // A new texture name of that size and format, without storage: what every create* starts from.
+  static GlTexture generate(int width, int height, GLenum internalFormat);
   GlHandle handle_;
   int width_ = 0, height_ = 0;
   GLenum format_ = 0;
