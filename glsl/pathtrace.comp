@@ -171,32 +171,28 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
       float uPick = rand01(rng);
       newDir = sampleDiffuseDirection(ns, uPick, rand2(rng));
 #endif
+#if defined(CAUSTICA_MIS) || defined(CAUSTICA_PUNCTUAL)
+      // The Lambertian vertex as every light estimate below sees it (vertex.glsl), built once.
+      Vertex v = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
+#endif
 #ifdef CAUSTICA_MIS
       // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
       // traced (not at the last vertex the depth limit allows), so both estimators end alike.
       if (depth + 1u < maxDepth) {
-        Bsdf lambert = makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0);
-        Vertex v = makeVertex(lambert, p, pError, ng, ns, dir, sigma, sigma);
         radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
       }
 #ifdef CAUSTICA_ENV
       // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
       // Not inside an absorbing medium: the ray could only leave through its boundary.
       vec2 uEnv = rand2(rng);
-      if (depth + 1u < maxDepth && sigma == vec3(0.0)) {
-        Vertex ve = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
-        radiance += beta * filt * addEnvironmentLight(ve, uEnv);
-      }
+      if (depth + 1u < maxDepth && sigma == vec3(0.0)) radiance += beta * filt * addEnvironmentLight(v, uEnv);
 #endif
 #endif
 #ifdef CAUSTICA_PUNCTUAL
       // Punctual lights: their own estimate, added to the emitters' (a sum of unbiased estimates);
       // in both integrators, since a bounce never finds a delta light.
       float uPunctual = rand01(rng);
-      if (depth + 1u < maxDepth) {
-        Vertex vp = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
-        radiance += beta * filt * addPunctualLight(vp, uPunctual);
-      }
+      if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(v, uPunctual);
 #endif
 #ifdef CAUSTICA_CASTERS
       float cosOut = dot(newDir, ns);
