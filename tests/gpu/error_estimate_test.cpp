@@ -9,6 +9,7 @@
 #include "gl_test_util.h"
 #include "gpu/adaptive_sampler.h"
 #include "scene/assets.h"
+#include "scene/environment.h"
 
 using namespace caustica;
 using namespace caustica::test;
@@ -73,6 +74,8 @@ namespace {
 std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h, const std::vector<int>& spps,
                                            int referenceSpp, int seeds) {
   Scene scene = loadScene(sourcePath("assets/scenes/" + name + ".gltf"));
+  // A scene without emitters (sun-glass) gets the default environment, as the command line gives it.
+  if (!sceneHasLights(scene)) scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
   Camera camera = sceneCamera(scene);
   RenderSettings rs;
   rs.width = w;

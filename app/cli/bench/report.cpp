@@ -134,7 +134,11 @@ std::string adaptiveGainText(const RunResult& adaptive, const RunResult& uniform
   const double effA = efficiency(caustic ? la.relMseCaustic : la.relMse, la.seconds);
   const double effU = efficiency(caustic ? lu.relMseCaustic : lu.relMse, lu.seconds);
   std::string text = "t(0.01) " + formatThresholdTime(a) + " against " + formatThresholdTime(u);
-  if (a.kind != ThresholdTime::Kind::Unknown && u.kind != ThresholdTime::Kind::Unknown && a.seconds > 0.0)
+  // A time already reached at the first checkpoint is only an upper bound: no ratio from it.
+  auto measured = [](const ThresholdTime& t) {
+    return t.kind == ThresholdTime::Kind::Interpolated || t.kind == ThresholdTime::Kind::Extrapolated;
+  };
+  if (measured(a) && measured(u) && a.seconds > 0.0)
     text += formatDouble(" (%.2fx less time)", u.seconds / a.seconds);
   return text + ", efficiency " + formatDouble("%.2fx", effA / effU);
 }
