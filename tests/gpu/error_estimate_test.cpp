@@ -116,11 +116,10 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
 // 512 spp, the estimate within 25 % of the measured relMSE, both averaged over 8 seeds (each line's
 // single runs are printed). Measured offline (llvmpipe, 8 seeds, 4096-spp reference; ratios at 8 /
 // 32 / 128 / 512 spp): cornell-glass 1.59 / 0.96 / 1.03 / 0.96, cornell-dispersion 1.18 / 1.20 /
-// 1.10 / 1.12, cornell-box 1.04 / 1.10 / 1.08. In this test (2048-spp reference; at 128 / 256 / 512
-// spp): the seven Cornell-type scenes 0.96-1.23 with 4 seeds (cornell-dispersion 1.23 / 1.00 / 1.07);
-// punctual-lights 1.23 / 1.23 / 1.13 with 8 seeds (with 4: 1.18 / 1.37 / 1.10, which failed: its
-// error is firefly-heavy, single runs 0.82-1.77), hence 8 seeds; sun-glass (default sky) 1.02 / 1.01
-// with 8. Below ~128 spp a caustic scene's 4-seed average moves
+// 1.10 / 1.12, cornell-box 1.04 / 1.10 / 1.08. This test (2048-spp reference, 8 seeds; at 128 / 256 /
+// 512 spp): every scene 0.94-1.23, the closest punctual-lights 1.23 / 1.23 / 1.13 and many-lights
+// 1.17 / 1.13 / 1.16 (with 4 seeds punctual-lights read 1.37 at 256 spp and failed: its error is
+// firefly-heavy, single runs 0.82-1.77), cornell-dispersion 1.16 / 0.94 / 1.12. Below ~128 spp a caustic scene's 4-seed average moves
 // by +-40 % (cornell-dispersion at 32 spp: 1.49 for seeds 1-4, 1.04 for seeds 5-8) and the estimate
 // is biased high: an isolated caustic pixel whose mean comes from paths rarer than 1 in 8 samples
 // (cornell-glass's focus is one pixel at 32x32) cannot be told from a firefly on a dark floor by the
