@@ -427,6 +427,7 @@ std::vector<gpu::BvhNode> packBvhNodes(const std::vector<BvhBinaryNode>& binary)
     return out;
   }
   // Depth-first, parents before children; a node's children are packed where it is popped.
+  out.reserve(binary.size() / 2 + 1);  // one per inner node: (binary nodes - 1) / 2
   std::vector<std::uint32_t> work{0};
   innerIndex[0] = 0;
   out.emplace_back();
