@@ -94,15 +94,18 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   buffers_[CAUSTICA_BINDING_TEXELS] = GlBuffer::fromVector(g.texels);
   buffers_[CAUSTICA_BINDING_TEXINFO] = GlBuffer::fromVector(g.texInfo);
   buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
+  bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], g.nodes.size(), buffers_[CAUSTICA_BINDING_TRIGEOM],
+                             g.triGeom.size(), scene.path);
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
   punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
   uploadCasters();
   lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
   Bounds sceneBounds;
-  if (!g.nodes.empty() && g.nodes[0].bmin.x <= g.nodes[0].bmax.x) {
-    sceneBounds.grow(g.nodes[0].bmin);
-    sceneBounds.grow(g.nodes[0].bmax);
+  glm::vec3 bvhLo, bvhHi;
+  if (bvhBounds(g.nodes, bvhLo, bvhHi)) {
+    sceneBounds.grow(bvhLo);
+    sceneBounds.grow(bvhHi);
   }
   pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
@@ -295,6 +298,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
   environment_.bind();
+  bvhTextures_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "gpu/bvh_textures.h"
 #include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
@@ -110,6 +111,7 @@ class Renderer {
   GpuScene gpuScene_;
   GlLimits limits_;
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
+  BvhTextures bvhTextures_;  // the traversal's views of the nodes and TriGeom buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
   std::vector<LightGroup> lightGroups_;

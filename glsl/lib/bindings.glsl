@@ -2,7 +2,10 @@
 // Struct layouts come from glsl/shared/gpu_layout.h (shared with C++); this file only binds them.
 #include "../shared/gpu_layout.h"
 
-layout(std430, binding = CAUSTICA_BINDING_NODES) readonly buffer NodeBuffer { BvhNode nodes[]; };
+// The BVH and the triangle positions for traversal come through buffer textures over the same buffers
+// (texelFetch is a vector gather on llvmpipe; an SSBO load there is a loop over the lanes).
+layout(binding = CAUSTICA_TEXUNIT_BVH_NODES) uniform usamplerBuffer bvhNodeTexels;  // 4 texels per BvhNode
+layout(binding = CAUSTICA_TEXUNIT_TRI_GEOM) uniform usamplerBuffer triGeomTexels;   // 3 texels per TriGeom
 layout(std430, binding = CAUSTICA_BINDING_TRIGEOM) readonly buffer TriGeomBuffer { TriGeom triGeom[]; };
 layout(std430, binding = CAUSTICA_BINDING_TRISHADE) readonly buffer TriShadeBuffer { TriShade triShade[]; };
 layout(std430, binding = CAUSTICA_BINDING_MATERIALS) readonly buffer MaterialBuffer { Material materials[]; };
