@@ -51,28 +51,31 @@ void pushRay(vec3 org, vec3 dir, vec3 weight, vec3 sigma, uint depth) {
 // Any hit with 0 < t < tmax that is not an emitter: the point lights stand in for the emissive
 // triangles, which therefore cast no shadows (a light's centre may lie inside its closed mesh).
 bool occludedByNonEmitter(vec3 org, vec3 dir, float tmax) {
-  if (!(nodes[0].bmin.x <= nodes[0].bmax.x)) return false;
+  if (!(bvhNode(0).bmin.x <= bvhNode(0).bmax.x)) return false;
   vec3 invDir = safeInverse(dir);
   float tnear;
-  if (!intersectAabb(org, invDir, nodes[0].bmin, nodes[0].bmax, tmax, tnear)) return false;
+  if (!intersectAabb(org, invDir, bvhNode(0).bmin, bvhNode(0).bmax, tmax, tnear)) return false;
   uint stack[CAUSTICA_BVH_STACK];
   uint sp = 0u;
   uint index = 0u;
   while (true) {
-    uint leftFirst = nodes[index].leftFirst;
-    uint triCount = nodes[index].triCount;
+    BvhNode node = bvhNode(index);
+    uint leftFirst = node.leftFirst;
+    uint triCount = node.triCount;
     if (triCount > 0u) {
       for (uint i = leftFirst; i < leftFirst + triCount; ++i) {
         float t, u, v;
-        if (intersectTriangle(org, dir, triGeom[i].v0.xyz, triGeom[i].v1.xyz, triGeom[i].v2.xyz, tmax, t, u, v) &&
-            !isEmissive(materials[floatBitsToUint(triGeom[i].v0.w)]))
+        TriGeom tg = triGeomAt(i);
+        if (intersectTriangle(org, dir, tg.v0.xyz, tg.v1.xyz, tg.v2.xyz, tmax, t, u, v) &&
+            !isEmissive(materials[floatBitsToUint(tg.v0.w)]))
           return true;
       }
     } else {
       uint left = leftFirst;
       float tl, tr;
-      bool hl = intersectAabb(org, invDir, nodes[left].bmin, nodes[left].bmax, tmax, tl);
-      bool hr = intersectAabb(org, invDir, nodes[left + 1u].bmin, nodes[left + 1u].bmax, tmax, tr);
+      BvhNode nl = bvhNode(left), nr = bvhNode(left + 1u);
+      bool hl = intersectAabb(org, invDir, nl.bmin, nl.bmax, tmax, tl);
+      bool hr = intersectAabb(org, invDir, nr.bmin, nr.bmax, tmax, tr);
       if (hl && hr) {
         uint first = tl <= tr ? left : left + 1u;
         if (sp < uint(CAUSTICA_BVH_STACK)) stack[sp++] = first == left ? left + 1u : left;
@@ -132,8 +135,11 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_VOLUME
     w *= exp(-r.sigma * hit.t);
 #endif
-    TriGeom g = triGeom[hit.tri];
-    TriShade s = triShade[hit.tri];
+    TriGeom g = triGeomAt(hit.tri);
+    vec3 sn0, sn1, sn2;
+    vec2 st0, st1, st2;
+    triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
+    triUvs(hit.tri, st0, st1, st2);
     float b0 = 1.0 - hit.u - hit.v;
     vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
     vec3 pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);
@@ -143,12 +149,12 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
     vec3 ngFront = cr / crLen;
     bool front = dot(r.dir, ngFront) < 0.0;
     vec3 ng = front ? ngFront : -ngFront;
-    vec3 nsRaw = b0 * s.n0.xyz + hit.u * s.n1.xyz + hit.v * s.n2.xyz;
+    vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
     float nsLen = length(nsRaw);
     vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
     if (dot(ns, ngFront) < 0.0) ns = -ns;
     if (!front) ns = -ns;
-    vec2 uv = b0 * vec2(s.n0.w, s.vt.x) + hit.u * vec2(s.n1.w, s.vt.y) + hit.v * vec2(s.n2.w, s.vt.z);
+    vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
     Material m = materials[floatBitsToUint(g.v0.w)];
 
     if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) radiance += w * materialEmission(m, uv);

@@ -7,6 +7,7 @@
 #include "scene/caustic_casters.h"
 #include "util/error.h"
 #include "shading/microfacet.h"
+#include "shading/oct_normal.h"
 #include "shading/sampling.h"
 
 namespace caustica {
@@ -145,14 +146,19 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triGeom = packTriGeom(scene.triangles, bvh);
-  g.triShade.resize(bvh.order.size());
+  // Shading words (gpu_layout.h): octahedral normals, then full-float texcoords only where textures
+  // read them (half floats would move a texel on large textures).
+  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  g.triShade.resize(bvh.order.size() * g.triShadeStride);
   for (size_t i = 0; i < bvh.order.size(); ++i) {
     const Triangle& t = scene.triangles[bvh.order[i]];
-    gpu::TriShade& s = g.triShade[i];
-    s.n0 = glm::vec4(t.n[0], t.uv[0].x);
-    s.n1 = glm::vec4(t.n[1], t.uv[1].x);
-    s.n2 = glm::vec4(t.n[2], t.uv[2].x);
-    s.vt = glm::vec4(t.uv[0].y, t.uv[1].y, t.uv[2].y, 0.0f);
+    std::uint32_t* w = g.triShade.data() + i * g.triShadeStride;
+    for (int k = 0; k < 3; ++k) w[k] = octEncode(t.n[k]);
+    if (g.triShadeStride == gpu::kTriShadeWordsTextured)
+      for (int k = 0; k < 3; ++k) {
+        w[3 + 2 * k] = floatBits(t.uv[k].x);
+        w[4 + 2 * k] = floatBits(t.uv[k].y);
+      }
   }
 
   for (const Material& m : scene.materials) {
@@ -234,14 +240,35 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
     lightItems.push_back(item);
   }
   // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
-  // TriShade.vt.w (leaf index + 1 as uint bits, 0: not in the tree).
+  // TriGeom.v1.w (leaf index + 1 as uint bits, 0: not in the tree).
   g.lightTree = buildLightTree(std::move(lightItems), g.triGeom.size());
-  for (size_t i = 0; i < g.triShade.size(); ++i)
-    g.triShade[i].vt.w = glm::uintBitsToFloat(g.lightTree.leafOf[i] == gpu::kInvalidIndex ? 0u : g.lightTree.leafOf[i] + 1u);
+  for (size_t i = 0; i < g.triGeom.size(); ++i)
+    g.triGeom[i].v1.w = glm::uintBitsToFloat(g.lightTree.leafOf[i] == gpu::kInvalidIndex ? 0u : g.lightTree.leafOf[i] + 1u);
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
   g.emitters = buildAliasTable(weights, tris);
   return g;
+}
+
+glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k) {
+  return octDecode(g.triShade[tri * g.triShadeStride + static_cast<std::size_t>(k)]);
+}
+
+glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k) {
+  if (g.triShadeStride != gpu::kTriShadeWordsTextured) return glm::vec2(0.0f);
+  const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + 3 + 2 * k;
+  return glm::vec2(glm::uintBitsToFloat(w[0]), glm::uintBitsToFloat(w[1]));
+}
+
+GpuSceneBytes gpuSceneBytes(const GpuScene& g) {
+  GpuSceneBytes b;
+  b.nodes = g.nodes.size() * sizeof(gpu::BvhNode);
+  b.triGeom = g.triGeom.size() * sizeof(gpu::TriGeom);
+  b.triShade = g.triShade.size() * 4;
+  b.materials = g.materials.size() * sizeof(gpu::Material);
+  b.lightTree = g.lightTree.nodes.size() * sizeof(gpu::LightNode);
+  b.textures = (g.texels.size() + g.texInfo.size() * gpu::kTexInfoWords) * 4;
+  return b;
 }
 
 }  // namespace caustica

@@ -31,7 +31,8 @@ bool hasRoughLobe(const Material& m);
 struct GpuScene {
   std::vector<gpu::BvhNode> nodes;
   std::vector<gpu::TriGeom> triGeom;    // BVH leaf order
-  std::vector<gpu::TriShade> triShade;  // BVH leaf order
+  std::vector<std::uint32_t> triShade;  // BVH leaf order, triShadeStride words per triangle (gpu_layout.h)
+  std::uint32_t triShadeStride = gpu::kTriShadeWords;  // kTriShadeWordsTextured when features.textures
   std::vector<gpu::Material> materials;
   std::vector<gpu::Emitter> emitters;   // alias table, one slot per emissive triangle (host only: counts, info)
   LightTree lightTree;                  // light tree over the same triangles: what the shaders sample (binding 4)
@@ -49,6 +50,18 @@ struct GpuScene {
 };
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh);
+
+// Vertex k's shading normal (unit, or zero where the mesh has none) and texcoord of triangle `tri`
+// (BVH leaf order) as the shaders decode them from GpuScene::triShade (tri_shade.glsl).
+glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k);
+glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k);  // (0, 0) in scenes without textures
+
+// What the scene occupies on the GPU, in bytes, by storage block (gpu/renderer.cpp uploads these).
+struct GpuSceneBytes {
+  std::size_t nodes = 0, triGeom = 0, triShade = 0, materials = 0, lightTree = 0, textures = 0;
+  std::size_t total() const { return nodes + triGeom + triShade + materials + lightTree + textures; }
+};
+GpuSceneBytes gpuSceneBytes(const GpuScene& g);
 
 // Vose's alias table over `weights` (non-negative, not all zero). Slot i holds item `items[i]`.
 std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items);

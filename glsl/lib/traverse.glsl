@@ -3,9 +3,9 @@
 //
 // Packing relied on (glsl/shared/gpu_layout.h, built by buildBvh/packTriGeom):
 //   BvhNode (32 bytes): bmin, bmax = world-space box; triCount == 0: inner node whose children are
-//     nodes[leftFirst] and nodes[leftFirst + 1] (always at higher indices than the parent);
-//     triCount > 0: leaf over triGeom[leftFirst .. leftFirst + triCount - 1].
-//   nodes[0] is the root; an empty scene has a root with bmin > bmax, rejected before any child is read.
+//     bvhNode(leftFirst) and bvhNode(leftFirst + 1) (always at higher indices than the parent);
+//     triCount > 0: leaf over triGeomAt(leftFirst .. leftFirst + triCount - 1).
+//   bvhNode(0) is the root; an empty scene has a root with bmin > bmax, rejected before any child is read.
 //   TriGeom: v0.xyz, v1.xyz, v2.xyz = world-space vertices in leaf order (v0.w = material bits, unused here).
 //   Tree depth (root = 1) is < CAUSTICA_BVH_STACK, and near-first traversal pushes at most one node per
 //   level, so the stack cannot overflow; the sp check only guards memory against a malformed tree.
@@ -23,21 +23,23 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   hit.u = 0.0;
   hit.v = 0.0;
   hit.tri = kInvalidIndex;
-  if (!(nodes[0].bmin.x <= nodes[0].bmax.x)) return false;  // empty scene
+  if (!(bvhNode(0).bmin.x <= bvhNode(0).bmax.x)) return false;  // empty scene
   vec3 invDir = safeInverse(dir);
   float tnear;
-  if (!intersectAabb(org, invDir, nodes[0].bmin, nodes[0].bmax, tmax, tnear)) return false;
+  if (!intersectAabb(org, invDir, bvhNode(0).bmin, bvhNode(0).bmax, tmax, tnear)) return false;
 
   uint stack[CAUSTICA_BVH_STACK];
   uint sp = 0u;
   uint index = 0u;
   while (true) {
-    uint leftFirst = nodes[index].leftFirst;
-    uint triCount = nodes[index].triCount;
+    BvhNode node = bvhNode(index);
+    uint leftFirst = node.leftFirst;
+    uint triCount = node.triCount;
     if (triCount > 0u) {
       for (uint i = leftFirst; i < leftFirst + triCount; ++i) {
         float t, u, v;
-        if (intersectTriangle(org, dir, triGeom[i].v0.xyz, triGeom[i].v1.xyz, triGeom[i].v2.xyz, hit.t,
+        TriGeom tg = triGeomAt(i);
+        if (intersectTriangle(org, dir, tg.v0.xyz, tg.v1.xyz, tg.v2.xyz, hit.t,
                               t, u, v)) {
           hit.t = t;
           hit.u = u;
@@ -48,8 +50,9 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
     } else {
       uint left = leftFirst;
       float tl, tr;
-      bool hl = intersectAabb(org, invDir, nodes[left].bmin, nodes[left].bmax, hit.t, tl);
-      bool hr = intersectAabb(org, invDir, nodes[left + 1u].bmin, nodes[left + 1u].bmax, hit.t, tr);
+      BvhNode nl = bvhNode(left), nr = bvhNode(left + 1u);
+      bool hl = intersectAabb(org, invDir, nl.bmin, nl.bmax, hit.t, tl);
+      bool hr = intersectAabb(org, invDir, nr.bmin, nr.bmax, hit.t, tr);
       if (hl && hr) {
         uint first = tl <= tr ? left : left + 1u;
         if (sp < uint(CAUSTICA_BVH_STACK)) stack[sp++] = first == left ? left + 1u : left;
@@ -69,29 +72,32 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
 
 // Any hit with 0 < t < tmax (shadow rays).
 bool traceOccluded(vec3 org, vec3 dir, float tmax) {
-  if (!(nodes[0].bmin.x <= nodes[0].bmax.x)) return false;  // empty scene
+  if (!(bvhNode(0).bmin.x <= bvhNode(0).bmax.x)) return false;  // empty scene
   vec3 invDir = safeInverse(dir);
   float tnear;
-  if (!intersectAabb(org, invDir, nodes[0].bmin, nodes[0].bmax, tmax, tnear)) return false;
+  if (!intersectAabb(org, invDir, bvhNode(0).bmin, bvhNode(0).bmax, tmax, tnear)) return false;
 
   uint stack[CAUSTICA_BVH_STACK];
   uint sp = 0u;
   uint index = 0u;
   while (true) {
-    uint leftFirst = nodes[index].leftFirst;
-    uint triCount = nodes[index].triCount;
+    BvhNode node = bvhNode(index);
+    uint leftFirst = node.leftFirst;
+    uint triCount = node.triCount;
     if (triCount > 0u) {
       for (uint i = leftFirst; i < leftFirst + triCount; ++i) {
         float t, u, v;
-        if (intersectTriangle(org, dir, triGeom[i].v0.xyz, triGeom[i].v1.xyz, triGeom[i].v2.xyz, tmax,
+        TriGeom tg = triGeomAt(i);
+        if (intersectTriangle(org, dir, tg.v0.xyz, tg.v1.xyz, tg.v2.xyz, tmax,
                               t, u, v))
           return true;
       }
     } else {
       uint left = leftFirst;
       float tl, tr;
-      bool hl = intersectAabb(org, invDir, nodes[left].bmin, nodes[left].bmax, tmax, tl);
-      bool hr = intersectAabb(org, invDir, nodes[left + 1u].bmin, nodes[left + 1u].bmax, tmax, tr);
+      BvhNode nl = bvhNode(left), nr = bvhNode(left + 1u);
+      bool hl = intersectAabb(org, invDir, nl.bmin, nl.bmax, tmax, tl);
+      bool hr = intersectAabb(org, invDir, nr.bmin, nr.bmax, tmax, tr);
       if (hl && hr) {
         uint first = tl <= tr ? left : left + 1u;
         if (sp < uint(CAUSTICA_BVH_STACK)) stack[sp++] = first == left ? left + 1u : left;
