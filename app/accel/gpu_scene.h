@@ -30,6 +30,7 @@ bool hasRoughLobe(const Material& m);
 
 struct GpuScene {
   std::vector<gpu::BvhNode> nodes;
+  std::size_t triangleCount = 0;        // triangles (TriGeom records), also when triGeom is not filled
   std::vector<gpu::TriGeom> triGeom;    // BVH leaf order
   std::vector<std::uint32_t> triShade;  // BVH leaf order, triShadeStride words per triangle (gpu_layout.h)
   std::uint32_t triShadeStride = gpu::kTriShadeWords;  // kTriShadeWordsTextured when features.textures
@@ -49,7 +50,13 @@ struct GpuScene {
   gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
 };
 
-GpuScene packScene(const Scene& scene, const Bvh& bvh);
+// `triangleArrays` false leaves triGeom and triShade empty: the Renderer packs and uploads them in
+// slices (packTriangleRange), so the host never holds them whole.
+GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays = true);
+// TriGeom records and TriShade words of triangles [first, first + count) (BVH leaf order) of a scene
+// packed by packScene (it needs g.lightTree.leafOf and g.triShadeStride), into geom and shade.
+void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, std::size_t first, std::size_t count,
+                       std::vector<gpu::TriGeom>& geom, std::vector<std::uint32_t>& shade);
 
 // Vertex k's shading normal (unit, or zero where the mesh has none) and texcoord of triangle `tri`
 // (BVH leaf order) as the shaders decode them from GpuScene::triShade (tri_shade.glsl).

@@ -83,7 +83,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   t0 = std::chrono::steady_clock::now();
   std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
   bvh_.nodes.clear();
-  gpuScene_ = packScene(scene, bvh_);
+  gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
   gpuScene_.nodes = std::move(nodes);
   load_.pack = since(t0);
 
@@ -95,11 +95,11 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   }
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
-  // Host copies the GPU will hold: the BVH's order (its statistics stay), the leaf map.
+  t0 = std::chrono::steady_clock::now();
+  uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
+  // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
-  t0 = std::chrono::steady_clock::now();
-  uploadSceneBuffers(g, bufferLayout_, buffers_);  // frees g.nodes, g.triGeom, g.triShade
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
   punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);

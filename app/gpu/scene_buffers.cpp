@@ -70,8 +70,8 @@ std::string SceneBufferLayout::describe() const {
 SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, const std::string& scenePath) {
   SceneBufferLayout l;
   l.nodes = {"BVH nodes", sizeof(gpu::BvhNode), g.nodes.size(), 0, 1, {}};
-  l.triGeom = {"triangles", sizeof(gpu::TriGeom), g.triGeom.size(), 0, 1, {}};
-  l.triShade = {"triangle shading data", 4, g.triShade.size(), 0, 1, {}};
+  l.triGeom = {"triangles", sizeof(gpu::TriGeom), g.triangleCount, 0, 1, {}};
+  l.triShade = {"triangle shading data", 4, g.triangleCount * g.triShadeStride, 0, 1, {}};
   planArray(l.nodes, limits.maxStorageBlockSize, 2, scenePath);  // children stay in one part
   planArray(l.triGeom, limits.maxStorageBlockSize, 1, scenePath);
   planArray(l.triShade, limits.maxStorageBlockSize, g.triShadeStride, scenePath);
@@ -89,11 +89,48 @@ SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, co
   return l;
 }
 
-void uploadSceneBuffers(GpuScene& g, const SceneBufferLayout& l, std::vector<GlBuffer>& buffers) {
+void uploadSceneBuffers(GpuScene& g, const Scene& scene, const Bvh& bvh, const SceneBufferLayout& l,
+                        std::vector<GlBuffer>& buffers) {
   if (buffers.size() < CAUSTICA_SSBO_COUNT) buffers.resize(CAUSTICA_SSBO_COUNT);
   uploadArray(g.nodes, l.nodes, CAUSTICA_BINDING_NODES, buffers);
-  uploadArray(g.triGeom, l.triGeom, CAUSTICA_BINDING_TRIGEOM, buffers);
-  uploadArray(g.triShade, l.triShade, CAUSTICA_BINDING_TRISHADE, buffers);
+  if (g.triGeom.size() == g.triangleCount && g.triShade.size() == g.triangleCount * g.triShadeStride) {
+    uploadArray(g.triGeom, l.triGeom, CAUSTICA_BINDING_TRIGEOM, buffers);
+    uploadArray(g.triShade, l.triShade, CAUSTICA_BINDING_TRISHADE, buffers);
+  } else {  // packed here in slices of 64 Ki triangles, straight into the blocks
+    const auto create = [&](const SplitArray& a, int binding) {
+      for (int k = 0; k < a.parts; ++k) {
+        const std::size_t first = static_cast<std::size_t>(k) * a.perPart;
+        const std::size_t n = std::min(a.perPart, a.count - std::min(first, a.count));
+        const int b = k == 0 ? binding : a.bindings[static_cast<std::size_t>(k - 1)];
+        if (buffers.size() <= static_cast<std::size_t>(b)) buffers.resize(static_cast<std::size_t>(b) + 1);
+        buffers[static_cast<std::size_t>(b)] = GlBuffer::create(n * a.elementBytes, nullptr);
+      }
+    };
+    create(l.triGeom, CAUSTICA_BINDING_TRIGEOM);
+    create(l.triShade, CAUSTICA_BINDING_TRISHADE);
+    // Writes elements [first, first + n) of array `a` (which may straddle a part boundary).
+    const auto write = [&](const SplitArray& a, int binding, std::size_t first, std::size_t n, const void* data) {
+      const auto* bytes = static_cast<const unsigned char*>(data);
+      while (n > 0) {
+        const std::size_t k = first / a.perPart, offset = first - k * a.perPart;
+        const std::size_t m = std::min(n, a.perPart - offset);
+        const int b = k == 0 ? binding : a.bindings[k - 1];
+        buffers[static_cast<std::size_t>(b)].update(offset * a.elementBytes, m * a.elementBytes, bytes);
+        bytes += m * a.elementBytes;
+        first += m;
+        n -= m;
+      }
+    };
+    std::vector<gpu::TriGeom> geom;
+    std::vector<std::uint32_t> shade;
+    const std::size_t slice = 65536;
+    for (std::size_t first = 0; first < g.triangleCount; first += slice) {
+      const std::size_t n = std::min(slice, g.triangleCount - first);
+      packTriangleRange(scene, bvh, g, first, n, geom, shade);
+      write(l.triGeom, CAUSTICA_BINDING_TRIGEOM, first, n, geom.data());
+      write(l.triShade, CAUSTICA_BINDING_TRISHADE, first * g.triShadeStride, n * g.triShadeStride, shade.data());
+    }
+  }
   buffers[CAUSTICA_BINDING_MATERIALS] = GlBuffer::fromVector(g.materials);
   buffers[CAUSTICA_BINDING_EMITTERS] = GlBuffer::fromVector(g.lightTree.nodes);
   // TexInfo records, then the texels; offsets on the GPU count from the start of the block.

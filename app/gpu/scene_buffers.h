@@ -35,8 +35,11 @@ struct SceneBufferLayout {
 SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, const std::string& scenePath);
 
 // Creates the storage buffers of `g` in `buffers` (indexed by binding; the counters buffer included) and
-// frees each host array as soon as its copy is on the GPU, so the host holds one copy at a time.
-void uploadSceneBuffers(GpuScene& g, const SceneBufferLayout& layout, std::vector<GlBuffer>& buffers);
+// frees each host array as soon as its copy is on the GPU, so the host holds one copy at a time. When
+// g.triGeom and g.triShade were not packed (packScene(..., false)), they are packed from `scene` and
+// `bvh` in slices straight into their blocks (the host never holds them whole).
+void uploadSceneBuffers(GpuScene& g, const Scene& scene, const Bvh& bvh, const SceneBufferLayout& layout,
+                        std::vector<GlBuffer>& buffers);
 
 // Reads TriGeom and TriShade back into `g` (the raster mode builds its mesh from them).
 void downloadSceneArrays(GpuScene& g, const SceneBufferLayout& layout, const std::vector<GlBuffer>& buffers);

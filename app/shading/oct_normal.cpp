@@ -39,15 +39,17 @@ std::uint32_t octEncode(const glm::vec3& n) {
     py = oy;
   }
   // The nearest grid point in the plane is not always the nearest in angle: try the four around it.
-  const glm::vec3 unit = n / std::sqrt(glm::dot(n, n));
+  // Angles compared in double (in float, 1 - cos of 1e-4 rad is below the rounding of dot products).
+  const glm::dvec3 unit = glm::normalize(glm::dvec3(n));
+  const auto error = [&](std::uint32_t w) { return glm::length(glm::cross(glm::dvec3(octDecode(w)), unit)); };
   const float fx = std::floor(std::fmin(std::fmax(px, -1.0f), 1.0f) * 32767.0f);
   const float fy = std::floor(std::fmin(std::fmax(py, -1.0f), 1.0f) * 32767.0f);
   std::uint32_t best = packSnorm(px) | packSnorm(py) << 16;
-  float bestDot = glm::dot(octDecode(best), unit);
+  double bestError = error(best);
   for (int i = 0; i < 4; ++i) {
     const std::uint32_t w = packSnorm((fx + float(i & 1)) / 32767.0f) | packSnorm((fy + float(i >> 1)) / 32767.0f) << 16;
-    const float d = glm::dot(octDecode(w), unit);
-    if (d > bestDot) bestDot = d, best = w;
+    const double e = error(w);
+    if (e < bestError && glm::dot(glm::dvec3(octDecode(w)), unit) > 0.0) bestError = e, best = w;
   }
   return best;
 }

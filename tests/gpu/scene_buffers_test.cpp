@@ -87,24 +87,28 @@ bool hasDefine(const std::vector<std::string>& d, const std::string& prefix) {
 TEST_CASE("scene buffers: a scene split over several storage blocks renders the same image, bit for bit") {
   const Scene scene = splitScene();
   for (RenderMode mode : {RenderMode::Path, RenderMode::Whitted, RenderMode::Raster}) {
-    CAPTURE(renderModeName(mode));
+    const std::string modeName = renderModeName(mode);
+    CAPTURE(modeName);
     const SplitRender whole = render(scene, mode, 8);
     CHECK(whole.layout.extraBlocks() == 0);
     CHECK_FALSE(hasDefine(whole.defines, "CAUSTICA_TRIGEOM_PARTS"));
     SplitRender split;
     {
-      // 10,000 bytes per block: TriGeom (48 B x 532) in 3 parts, TriShade (36 B) and nodes in 2.
+      // 10,000 bytes per block: every array in 2 to 4 parts (TriGeom 48 B, TriShade 36 B per triangle).
       ScopedEnv limit("CAUSTICA_MAX_SSBO_BYTES", "10000");
       split = render(scene, mode, 8);
     }
-    CHECK(split.layout.triGeom.parts == 3);
-    CHECK(split.layout.triShade.parts == 2);
-    CHECK(split.layout.nodes.parts >= 2);
-    CHECK(hasDefine(split.defines, "CAUSTICA_TRIGEOM_PARTS=3"));
-    CHECK(hasDefine(split.defines, "CAUSTICA_TRISHADE_PARTS=2"));
-    CHECK(hasDefine(split.defines, "CAUSTICA_NODES_PARTS="));
+    for (const SplitArray* a : {&split.layout.nodes, &split.layout.triGeom, &split.layout.triShade}) {
+      CAPTURE(a->name);
+      CHECK(a->parts >= 2);
+      CHECK(a->perPart * a->elementBytes <= 10000);
+      CHECK(a->count > (a->parts - 1) * a->perPart);  // every part holds something
+    }
+    CHECK(hasDefine(split.defines, "CAUSTICA_TRIGEOM_PARTS=" + std::to_string(split.layout.triGeom.parts)));
+    CHECK(hasDefine(split.defines, "CAUSTICA_TRISHADE_PARTS=" + std::to_string(split.layout.triShade.parts)));
+    CHECK(hasDefine(split.defines, "CAUSTICA_NODES_PARTS=" + std::to_string(split.layout.nodes.parts)));
     REQUIRE(split.image.rgb.size() == whole.image.rgb.size());
-    CHECK(meanOf(whole.image) > 0.05);  // lit: the comparison below is not of two black images
+    CHECK(meanOf(whole.image) > 0.02);  // lit (measured 0.044): the comparison below is not of two black images
     CHECK(std::memcmp(split.image.rgb.data(), whole.image.rgb.data(), whole.image.rgb.size() * sizeof(float)) == 0);
   }
 }
@@ -113,7 +117,7 @@ TEST_CASE("scene buffers: GL 4.3's 8 storage blocks still split one array in two
   const Scene scene = splitScene();
   const SplitRender whole = render(scene, RenderMode::Path, 4);
   ScopedEnv blocks("CAUSTICA_MAX_SSBO_BLOCKS", "8");
-  ScopedEnv limit("CAUSTICA_MAX_SSBO_BYTES", "25000");  // TriGeom 25,536 B: 2 parts; nodes, TriShade fit in one
+  ScopedEnv limit("CAUSTICA_MAX_SSBO_BYTES", "25000");  // TriGeom (~29 KB) in 2 parts; nodes, TriShade fit in one
   const SplitRender split = render(scene, RenderMode::Path, 4);
   CHECK(split.layout.triGeom.parts == 2);
   CHECK(split.layout.extraBlocks() == 1);

@@ -10,7 +10,7 @@
 
 using namespace caustica;
 
-TEST_CASE("octahedral normals: decoded within 3e-5 rad of the input, unit length, zero kept") {
+TEST_CASE("octahedral normals: decoded within 5e-5 rad of the input, unit length, zero kept") {
   std::mt19937 rng(7);
   std::normal_distribution<float> g(0.0f, 1.0f);
   double worst = 0.0, sum = 0.0;
@@ -26,13 +26,17 @@ TEST_CASE("octahedral normals: decoded within 3e-5 rad of the input, unit length
     sum += angle;
   }
   MESSAGE("octahedral normals: worst " << worst << " rad, mean " << sum / n << " rad");
-  // Measured: worst 1.9e-5 rad, mean 6e-6 rad (16-bit snorm per coordinate: grid step 3e-5 of the square).
-  CHECK(worst < 3e-5);
+  // Measured: worst 4.3e-5 rad, mean 2.1e-5 rad (16-bit snorm per coordinate: grid step 3e-5 of the
+  // square). Rounding each coordinate to the nearest grid point, without octEncode's search of the four
+  // around it, gives worst 6.4e-5 rad (and 1.25e-4 when that search compared float dot products), which fails.
+  CHECK(worst < 5e-5);
+  CHECK(sum / n < 2.5e-5);
   for (glm::vec3 v : {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::vec3(0, -1, 0),
                       glm::vec3(1, 1, -1), glm::vec3(-1, 1e-7f, -1e-7f)}) {
     CAPTURE(v);
     const glm::vec3 d = octDecode(octEncode(v));
-    CHECK(glm::dot(d, glm::normalize(v)) > 1.0f - 1e-9f);
+    CHECK(glm::dot(d, glm::normalize(v)) > 0.0f);
+    CHECK(glm::length(glm::cross(d, glm::normalize(v))) < 5e-5f);
   }
   CHECK(octEncode(glm::vec3(0.0f)) == gpu::kOctZeroNormal);
   CHECK(octEncode(glm::vec3(NAN, 0.0f, 1.0f)) == gpu::kOctZeroNormal);
