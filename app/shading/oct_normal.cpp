@@ -8,10 +8,6 @@
 namespace caustica {
 
 namespace {
-std::uint32_t packSnorm(float x) {  // GLSL packSnorm2x16 of one component
-  const float r = std::round(std::fmin(std::fmax(x, -1.0f), 1.0f) * 32767.0f);
-  return static_cast<std::uint32_t>(static_cast<std::uint16_t>(static_cast<std::int16_t>(r)));
-}
 float unpackSnorm(std::uint32_t bits) {  // GLSL unpackSnorm2x16 of one component
   const auto v = static_cast<std::int16_t>(static_cast<std::uint16_t>(bits & 0xffffu));
   return std::fmin(std::fmax(static_cast<float>(v) / 32767.0f, -1.0f), 1.0f);
@@ -28,6 +24,18 @@ glm::vec3 octDecode(std::uint32_t w) {
   return glm::normalize(n);
 }
 
+namespace {
+// The direction octDecode gives grid point (ix, iy) (snorm integers), before its normalize.
+glm::vec3 octPoint(float ix, float iy) {
+  const float px = std::fmin(std::fmax(ix / 32767.0f, -1.0f), 1.0f), py = std::fmin(std::fmax(iy / 32767.0f, -1.0f), 1.0f);
+  glm::vec3 q(px, py, 1.0f - std::fabs(px) - std::fabs(py));
+  const float t = std::fmax(-q.z, 0.0f);
+  q.x += q.x >= 0.0f ? -t : t;
+  q.y += q.y >= 0.0f ? -t : t;
+  return q;
+}
+}  // namespace
+
 std::uint32_t octEncode(const glm::vec3& n) {
   const float l1 = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
   if (!(l1 > 0.0f) || !std::isfinite(l1)) return gpu::kOctZeroNormal;
@@ -38,20 +46,24 @@ std::uint32_t octEncode(const glm::vec3& n) {
     px = ox;
     py = oy;
   }
-  // The nearest grid point in the plane is not always the nearest in angle: try the four around it.
-  // Angles compared in double (in float, 1 - cos of 1e-4 rad is below the rounding of dot products).
-  const glm::dvec3 unit = glm::normalize(glm::dvec3(n));
-  const auto error = [&](std::uint32_t w) { return glm::length(glm::cross(glm::dvec3(octDecode(w)), unit)); };
+  // The nearest grid point in the plane is not always the nearest in angle: of the four around the
+  // point, take the one whose direction q has the smallest sin^2 of the angle to n, |q x n|^2 / |q|^2
+  // (no 1 - cos: in float that rounds to 0 at these angles).
+  const glm::vec3 u = n / l1;
   const float fx = std::floor(std::fmin(std::fmax(px, -1.0f), 1.0f) * 32767.0f);
   const float fy = std::floor(std::fmin(std::fmax(py, -1.0f), 1.0f) * 32767.0f);
-  std::uint32_t best = packSnorm(px) | packSnorm(py) << 16;
-  double bestError = error(best);
+  float bestX = fx, bestY = fy, bestError = 3.0e38f;
   for (int i = 0; i < 4; ++i) {
-    const std::uint32_t w = packSnorm((fx + float(i & 1)) / 32767.0f) | packSnorm((fy + float(i >> 1)) / 32767.0f) << 16;
-    const double e = error(w);
-    if (e < bestError && glm::dot(glm::dvec3(octDecode(w)), unit) > 0.0) bestError = e, best = w;
+    const float ix = std::fmin(fx + float(i & 1), 32767.0f), iy = std::fmin(fy + float(i >> 1), 32767.0f);
+    const glm::vec3 q = octPoint(ix, iy);
+    const glm::vec3 c = glm::cross(q, u);
+    const float e = glm::dot(c, c) / glm::dot(q, q);
+    if (e < bestError && glm::dot(q, u) > 0.0f) bestError = e, bestX = ix, bestY = iy;
   }
-  return best;
+  const auto bits = [](float v) {
+    return static_cast<std::uint32_t>(static_cast<std::uint16_t>(static_cast<std::int16_t>(v)));
+  };
+  return bits(bestX) | bits(bestY) << 16;
 }
 
 }  // namespace caustica
