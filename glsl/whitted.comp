@@ -7,6 +7,8 @@
 #include "lib/sampling.glsl"
 #include "lib/spawn.glsl"
 #include "lib/intersect.glsl"
+bool whittedOccluder(uint tri);  // below: emitters do not occlude in this mode
+#define CAUSTICA_OCCLUDER_FILTER(tri) whittedOccluder(tri)
 #include "lib/traverse.glsl"
 #include "lib/camera.glsl"
 #include "lib/textures.glsl"
@@ -50,48 +52,9 @@ void pushRay(vec3 org, vec3 dir, vec3 weight, vec3 sigma, uint depth) {
 
 // Any hit with 0 < t < tmax that is not an emitter: the point lights stand in for the emissive
 // triangles, which therefore cast no shadows (a light's centre may lie inside its closed mesh).
-bool occludedByNonEmitter(vec3 org, vec3 dir, float tmax) {
-  if (!(bvhNode(0).bmin.x <= bvhNode(0).bmax.x)) return false;
-  vec3 invDir = safeInverse(dir);
-  float tnear;
-  if (!intersectAabb(org, invDir, bvhNode(0).bmin, bvhNode(0).bmax, tmax, tnear)) return false;
-  uint stack[CAUSTICA_BVH_STACK];
-  uint sp = 0u;
-  uint index = 0u;
-  while (true) {
-    BvhNode node = bvhNode(index);
-    uint leftFirst = node.leftFirst;
-    uint triCount = node.triCount;
-    if (triCount > 0u) {
-      for (uint i = leftFirst; i < leftFirst + triCount; ++i) {
-        float t, u, v;
-        TriGeom tg = triGeomAt(i);
-        if (intersectTriangle(org, dir, tg.v0.xyz, tg.v1.xyz, tg.v2.xyz, tmax, t, u, v) &&
-            !isEmissive(materials[floatBitsToUint(tg.v0.w)]))
-          return true;
-      }
-    } else {
-      uint left = leftFirst;
-      float tl, tr;
-      BvhNode nl = bvhNode(left), nr = bvhNode(left + 1u);
-      bool hl = intersectAabb(org, invDir, nl.bmin, nl.bmax, tmax, tl);
-      bool hr = intersectAabb(org, invDir, nr.bmin, nr.bmax, tmax, tr);
-      if (hl && hr) {
-        uint first = tl <= tr ? left : left + 1u;
-        if (sp < uint(CAUSTICA_BVH_STACK)) stack[sp++] = first == left ? left + 1u : left;
-        index = first;
-        continue;
-      }
-      if (hl || hr) {
-        index = hl ? left : left + 1u;
-        continue;
-      }
-    }
-    if (sp == 0u) break;
-    index = stack[--sp];
-  }
-  return false;
-}
+// traceOccluded with whittedOccluder as its filter (traverse.glsl, CAUSTICA_OCCLUDER_FILTER).
+bool whittedOccluder(uint tri) { return !isEmissive(materials[floatBitsToUint(triGeomAt(tri).v0.w)]); }
+bool occludedByNonEmitter(vec3 org, vec3 dir, float tmax) { return traceOccluded(org, dir, tmax); }
 
 // Direct light from every point light at p, with a sharp shadow ray each (radiance towards wv).
 vec3 directLight(vec3 p, vec3 pError, vec3 ng, vec3 ns, vec3 wv, vec3 base, float roughness, vec3 sigma) {

@@ -1,4 +1,4 @@
-// bvh.cpp — binned-SAH BVH builder (flattened to 32-byte gpu::BvhNode) and the C++ twins of the
+// bvh.cpp — binned-SAH BVH builder (a binary tree, packed into 64-byte gpu::BvhNode) and the C++ twins of the
 // GLSL ray–triangle test (intersect.glsl) and stack traversal (traverse.glsl). All positions and
 // distances are in world space; t is measured in units of |ray.dir|.
 #include "accel/bvh.h"
@@ -139,8 +139,9 @@ Box triangleBox(const Triangle& tri) {
 Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
   if (options.bins < 2 || options.bins > kMaxBins)
     throw Error("bvh.cpp: BvhBuildOptions::bins must be in [2, " + std::to_string(kMaxBins) + "]");
-  if (options.maxLeafSize < 1) throw Error("bvh.cpp: BvhBuildOptions::maxLeafSize must be >= 1");
-  if (triangles.size() >= std::size_t(0x7fffffff))
+  if (options.maxLeafSize < 1 || options.maxLeafSize > int(gpu::kBvhMaxLeafSize))
+    throw Error("bvh.cpp: BvhBuildOptions::maxLeafSize must be in [1, " + std::to_string(gpu::kBvhMaxLeafSize) + "]");
+  if (triangles.size() > std::size_t(gpu::kBvhFirstMask))
     throw Error("bvh.cpp: too many triangles (" + std::to_string(triangles.size()) + ")");
 
   Bvh bvh;
@@ -150,12 +151,13 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
   const double ct = options.costTraversal, ci = options.costIntersect;
 
   if (n == 0) {  // one empty node with an inverted box: traversal rejects it before reading children
-    gpu::BvhNode empty{};
+    BvhBinaryNode empty{};
     empty.bmin = glm::vec3(kInf);
     empty.bmax = glm::vec3(-kInf);
-    bvh.nodes.push_back(empty);
+    bvh.binary.push_back(empty);
     bvh.depth = 1;
     bvh.leafCount = 1;
+    bvh.nodes = packBvhNodes(bvh.binary);
     return bvh;
   }
 
@@ -163,8 +165,8 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
   prims.reserve(n);
   for (std::uint32_t i = 0; i < n; ++i) prims.emplace_back(triangleBox(triangles[i]), i);
 
-  bvh.nodes.reserve(2 * std::size_t(n));
-  bvh.nodes.emplace_back();
+  bvh.binary.reserve(2 * std::size_t(n));
+  bvh.binary.emplace_back();
   std::vector<WorkItem> work;
   work.push_back({0, 0, n, 1, Box{}, Box{}});
   boundsOfRange(prims, 0, n, work.back().box, work.back().cbox);
@@ -179,13 +181,13 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     work.pop_back();
     const double nodeArea = item.box.halfArea();
     const double relArea = rootAreaOk ? nodeArea / rootArea : 1.0;
-    gpu::BvhNode& out = bvh.nodes[item.node];
+    BvhBinaryNode& out = bvh.binary[item.node];
     out.bmin = glm::vec3(item.box.lo[0], item.box.lo[1], item.box.lo[2]);
     out.bmax = glm::vec3(item.box.hi[0], item.box.hi[1], item.box.hi[2]);
 
     auto makeLeaf = [&]() {
       if (item.count > maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
-      gpu::BvhNode& leaf = bvh.nodes[item.node];
+      BvhBinaryNode& leaf = bvh.binary[item.node];
       leaf.leftFirst = item.first;
       leaf.triCount = item.count;
       bvh.leafCount++;
@@ -298,12 +300,12 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     right.first = item.first + left.count;
     right.count = item.count - left.count;
 
-    left.node = std::uint32_t(bvh.nodes.size());
+    left.node = std::uint32_t(bvh.binary.size());
     right.node = left.node + 1;
-    bvh.nodes[item.node].leftFirst = left.node;
-    bvh.nodes[item.node].triCount = 0;
-    bvh.nodes.emplace_back();
-    bvh.nodes.emplace_back();
+    bvh.binary[item.node].leftFirst = left.node;
+    bvh.binary[item.node].triCount = 0;
+    bvh.binary.emplace_back();
+    bvh.binary.emplace_back();
     sah += ct * relArea;
     work.push_back(right);
     work.push_back(left);
@@ -312,9 +314,89 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
   if (bvh.depth >= CAUSTICA_BVH_STACK)
     throw Error("bvh.cpp: BVH depth " + std::to_string(bvh.depth) + " exceeds the traversal stack");
   bvh.sahCost = float(sah);
+  bvh.nodes = packBvhNodes(bvh.binary);
   bvh.order.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
   return bvh;
+}
+
+std::vector<gpu::BvhNode> packBvhNodes(const std::vector<BvhBinaryNode>& binary) {
+  std::vector<gpu::BvhNode> out;
+  if (binary.empty()) return out;
+  const std::uint32_t kEmptyRef = gpu::kBvhEmptyRef;
+  const glm::vec3 inf(kInf);
+  // Ref of binary node b once packed: leaves in place, inner nodes by the index `innerIndex` gives.
+  std::vector<std::uint32_t> innerIndex(binary.size(), gpu::kInvalidIndex);
+  auto leafRef = [&](const BvhBinaryNode& b) {
+    if (b.leftFirst > gpu::kBvhFirstMask || b.triCount > gpu::kBvhMaxLeafSize)
+      throw Error("bvh.cpp: leaf out of the packed range (internal error)");
+    return gpu::kBvhLeafBit | b.triCount << gpu::kBvhCountShift | b.leftFirst;
+  };
+  const BvhBinaryNode& root = binary[0];
+  if (root.triCount > 0 || !(root.bmin.x <= root.bmax.x)) {  // one leaf, or an empty tree
+    gpu::BvhNode n{};
+    const bool empty = root.triCount == 0;
+    n.lmin = empty ? inf : root.bmin;
+    n.lmax = empty ? -inf : root.bmax;
+    n.left = empty ? kEmptyRef : leafRef(root);
+    n.rmin = inf;
+    n.rmax = -inf;
+    n.right = kEmptyRef;
+    out.push_back(n);
+    return out;
+  }
+  // Depth-first, parents before children; a node's children are packed where it is popped.
+  std::vector<std::uint32_t> work{0};
+  innerIndex[0] = 0;
+  out.emplace_back();
+  while (!work.empty()) {
+    const std::uint32_t b = work.back();
+    work.pop_back();
+    const BvhBinaryNode& node = binary[b];
+    const std::uint32_t l = node.leftFirst, r = node.leftFirst + 1;
+    gpu::BvhNode n{};
+    n.lmin = binary[l].bmin;
+    n.lmax = binary[l].bmax;
+    n.rmin = binary[r].bmin;
+    n.rmax = binary[r].bmax;
+    std::uint32_t refs[2];
+    const std::uint32_t kids[2] = {l, r};
+    for (int k = 0; k < 2; ++k) {
+      const BvhBinaryNode& c = binary[kids[k]];
+      if (c.triCount > 0) {
+        refs[k] = leafRef(c);
+      } else {
+        innerIndex[kids[k]] = std::uint32_t(out.size());
+        refs[k] = innerIndex[kids[k]];
+        out.emplace_back();
+      }
+    }
+    n.left = refs[0];
+    n.right = refs[1];
+    out[innerIndex[b]] = n;
+    for (int k = 1; k >= 0; --k)
+      if (binary[kids[k]].triCount == 0) work.push_back(kids[k]);
+  }
+  return out;
+}
+
+bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3& hi) {
+  lo = glm::vec3(kInf);
+  hi = glm::vec3(-kInf);
+  if (nodes.empty()) return false;
+  const gpu::BvhNode& r = nodes[0];
+  bool any = false;
+  if (r.left != gpu::kBvhEmptyRef) {
+    lo = glm::min(lo, r.lmin);
+    hi = glm::max(hi, r.lmax);
+    any = true;
+  }
+  if (r.right != gpu::kBvhEmptyRef) {
+    lo = glm::min(lo, r.rmin);
+    hi = glm::max(hi, r.rmax);
+    any = true;
+  }
+  return any;
 }
 
 std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh) {
@@ -340,22 +422,30 @@ inline glm::vec3 permuteToKz(const glm::vec3& a, int kz) {
 
 }  // namespace
 
+RayShear makeRayShear(const glm::vec3& dir) {
+  const glm::vec3 ad = glm::abs(dir);
+  RayShear s;
+  s.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+  const glm::vec3 d = permuteToKz(dir, s.kz);
+  s.sz = d.z == 0.0f ? 0.0f : 1.0f / d.z;
+  s.sx = -d.x * s.sz;
+  s.sy = -d.y * s.sz;
+  return s;
+}
+
 // Woop, Benthin, Wald 2013 ("Watertight ray/triangle intersection"), in the form of pbrt-v4's
 // IntersectTriangle: translate to the ray origin, permute so the largest direction component is z,
 // shear so the ray is +z, then 2D edge functions. Shared edges give exactly negated edge functions,
 // so no ray passes between two triangles. Exactly zero edge functions are recomputed in double.
-bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
-                       float tmax, float& t, float& u, float& v) {
-  const glm::vec3 ad = glm::abs(ray.dir);
-  const int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
-  const glm::vec3 d = permuteToKz(ray.dir, kz);
-  if (d.z == 0.0f) return false;  // zero direction
-  const float sz = 1.0f / d.z;
-  const float sx = -d.x * sz, sy = -d.y * sz;
+bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const glm::vec3& p0, const glm::vec3& p1,
+                              const glm::vec3& p2, float tmax, float& t, float& u, float& v) {
+  if (rs.sz == 0.0f) return false;  // zero direction
+  const float sx = rs.sx, sy = rs.sy, sz = rs.sz;
+  const int kz = rs.kz;
 
-  const glm::vec3 a = permuteToKz(p0 - ray.origin, kz);
-  const glm::vec3 b = permuteToKz(p1 - ray.origin, kz);
-  const glm::vec3 c = permuteToKz(p2 - ray.origin, kz);
+  const glm::vec3 a = permuteToKz(p0 - origin, kz);
+  const glm::vec3 b = permuteToKz(p1 - origin, kz);
+  const glm::vec3 c = permuteToKz(p2 - origin, kz);
   const float ax = a.x + sx * a.z, ay = a.y + sy * a.z;
   const float bx = b.x + sx * b.z, by = b.y + sy * b.z;
   const float cx = c.x + sx * c.z, cy = c.y + sy * c.z;
@@ -400,6 +490,11 @@ bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
   return true;
 }
 
+bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
+                       float tmax, float& t, float& u, float& v) {
+  return intersectTriangleSheared(ray.origin, makeRayShear(ray.dir), p0, p1, p2, tmax, t, u, v);
+}
+
 namespace {
 
 constexpr float kDirTiny = 1e-20f;
@@ -432,29 +527,54 @@ inline bool intersectAabb(const glm::vec3& org, const glm::vec3& invDir, const g
   return tnear <= tfar;
 }
 
-// Traversal shared by closest and any hit: near child first, far child on a fixed-size stack.
+// Traversal shared by closest and any hit, in the GLSL twin's order: near child first, the far one on
+// a fixed-size stack with its entry distance; a popped subtree that starts beyond the closest hit is
+// skipped (closest hit only). Leaves are packed into the refs (gpu_layout.h, BvhNode).
 template <bool kAnyHit>
 Hit traverse(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriGeom>& tris,
              const Ray& ray, float tmax) {
   Hit hit;
   if (nodes.empty()) return hit;
-  const gpu::BvhNode& root = nodes[0];
-  if (!(root.bmin.x <= root.bmax.x)) return hit;  // empty scene (inverted root box)
   const glm::vec3 invDir = safeInverse(ray.dir);
-  float tnear;
-  if (!intersectAabb(ray.origin, invDir, root.bmin, root.bmax, tmax, tnear)) return hit;
+  const RayShear rs = makeRayShear(ray.dir);
 
   float closest = tmax;
-  std::uint32_t stack[CAUSTICA_BVH_STACK];
+  std::uint32_t stackRef[CAUSTICA_BVH_STACK];
+  float stackT[CAUSTICA_BVH_STACK];
   std::uint32_t sp = 0;
-  std::uint32_t index = 0;
+  std::uint32_t ref = 0;  // the root, an inner node
+  // Next stacked ref that may still hold a closer hit, or kInvalidIndex.
+  auto pop = [&]() -> std::uint32_t {
+    while (sp > 0) {
+      --sp;
+      if (kAnyHit || stackT[sp] <= closest * kBoxPad) return stackRef[sp];
+    }
+    return gpu::kInvalidIndex;
+  };
   for (;;) {
-    const gpu::BvhNode& node = nodes[index];
-    if (node.triCount > 0) {
-      for (std::uint32_t i = node.leftFirst; i < node.leftFirst + node.triCount; ++i) {
+    if ((ref & gpu::kBvhLeafBit) == 0) {
+      const gpu::BvhNode& node = nodes[ref];
+      float tl, tr;
+      const bool hl = intersectAabb(ray.origin, invDir, node.lmin, node.lmax, closest, tl);
+      const bool hr = intersectAabb(ray.origin, invDir, node.rmin, node.rmax, closest, tr);
+      const bool leftFirst = hl && (!hr || tl <= tr);
+      // The builder bounds the depth, so the stack never overflows; the guard only protects memory.
+      if (hl && hr && sp < CAUSTICA_BVH_STACK) {
+        stackRef[sp] = leftFirst ? node.right : node.left;
+        stackT[sp] = leftFirst ? tr : tl;
+        ++sp;
+      }
+      if (hl || hr) {
+        ref = leftFirst ? node.left : node.right;
+        continue;
+      }
+    } else {
+      const std::uint32_t first = ref & gpu::kBvhFirstMask;
+      const std::uint32_t count = (ref >> gpu::kBvhCountShift) & 15u;
+      for (std::uint32_t i = first; i < first + count; ++i) {
         const gpu::TriGeom& g = tris[i];
         float t, u, v;
-        if (intersectTriangle(ray, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u, v)) {
+        if (intersectTriangleSheared(ray.origin, rs, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u, v)) {
           closest = t;
           hit.t = t;
           hit.u = u;
@@ -463,25 +583,9 @@ Hit traverse(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriG
           if (kAnyHit) return hit;
         }
       }
-    } else {
-      const std::uint32_t left = node.leftFirst;
-      float tl, tr;
-      const bool hl = intersectAabb(ray.origin, invDir, nodes[left].bmin, nodes[left].bmax, closest, tl);
-      const bool hr = intersectAabb(ray.origin, invDir, nodes[left + 1].bmin, nodes[left + 1].bmax, closest, tr);
-      if (hl && hr) {
-        const std::uint32_t first = tl <= tr ? left : left + 1;
-        // The builder bounds the depth, so this never overflows; the guard only protects memory.
-        if (sp < CAUSTICA_BVH_STACK) stack[sp++] = first == left ? left + 1 : left;
-        index = first;
-        continue;
-      }
-      if (hl || hr) {
-        index = hl ? left : left + 1;
-        continue;
-      }
     }
-    if (sp == 0) break;
-    index = stack[--sp];
+    ref = pop();
+    if (ref == gpu::kInvalidIndex) break;
   }
   return hit;
 }

@@ -91,6 +91,24 @@ GlTexture GlTexture::generate(int width, int height, GLenum internalFormat) {
   return t;
 }
 
+GlBufferTexture GlBufferTexture::create(const GlBuffer& buffer, GLenum internalFormat) {
+  GlBufferTexture t;
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  t.handle_ = GlHandle(id, deleteTexture);
+  glBindTexture(GL_TEXTURE_BUFFER, id);
+  glTexBuffer(GL_TEXTURE_BUFFER, internalFormat, buffer.id());
+  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  checkGlError("buffer texture creation");
+  return t;
+}
+
+void GlBufferTexture::bind(GLuint unit) const {
+  glActiveTexture(GL_TEXTURE0 + unit);
+  glBindTexture(GL_TEXTURE_BUFFER, id());
+  glActiveTexture(GL_TEXTURE0);
+}
+
 GlTexture GlTexture::create2D(int width, int height, GLenum internalFormat) {
   GlTexture t = generate(width, height, internalFormat);
   const GLuint id = t.id();

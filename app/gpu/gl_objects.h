@@ -94,6 +94,19 @@ class GlTexture {
   GLenum format_ = 0;
 };
 
+// A buffer texture (GL_TEXTURE_BUFFER): the bytes of a GlBuffer read as texels of `internalFormat`
+// (e.g. GL_RGBA32UI) by texelFetch on a (u)samplerBuffer. The buffer must outlive the texture's use.
+class GlBufferTexture {
+ public:
+  GlBufferTexture() = default;
+  static GlBufferTexture create(const GlBuffer& buffer, GLenum internalFormat);
+  void bind(GLuint unit) const;  // on texture unit `unit`; leaves GL_TEXTURE0 active
+  GLuint id() const { return handle_.id(); }
+
+ private:
+  GlHandle handle_;
+};
+
 // A linked compute program (or, for the raster mode, a vertex + fragment program).
 class GlProgram {
  public:

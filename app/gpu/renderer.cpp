@@ -85,18 +85,22 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   bvh_.nodes.clear();
   gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
   gpuScene_.nodes = std::move(nodes);
+  std::vector<BvhBinaryNode>().swap(bvh_.binary);  // the builder's tree: the GPU nodes were made from it
   load_.pack = since(t0);
 
   GpuScene& g = gpuScene_;
   Bounds sceneBounds;
-  if (!g.nodes.empty() && g.nodes[0].bmin.x <= g.nodes[0].bmax.x) {
-    sceneBounds.grow(g.nodes[0].bmin);
-    sceneBounds.grow(g.nodes[0].bmax);
+  glm::vec3 bvhLo, bvhHi;
+  if (bvhBounds(g.nodes, bvhLo, bvhHi)) {
+    sceneBounds.grow(bvhLo);
+    sceneBounds.grow(bvhHi);
   }
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
   t0 = std::chrono::steady_clock::now();
   uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
+  bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
+                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path);
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
@@ -294,6 +298,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
   environment_.bind();
+  bvhTextures_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "gpu/bvh_textures.h"
 #include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
@@ -127,6 +128,7 @@ class Renderer {
   SceneBufferLayout bufferLayout_;
   GlLimits limits_;
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
+  BvhTextures bvhTextures_;  // the traversal's views of the nodes and TriGeom buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
   std::vector<LightGroup> lightGroups_;

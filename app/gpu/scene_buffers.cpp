@@ -72,8 +72,9 @@ SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, co
   l.nodes = {"BVH nodes", sizeof(gpu::BvhNode), g.nodes.size(), 0, 1, {}};
   l.triGeom = {"triangles", sizeof(gpu::TriGeom), g.triangleCount, 0, 1, {}};
   l.triShade = {"triangle shading data", 4, g.triangleCount * g.triShadeStride, 0, 1, {}};
-  planArray(l.nodes, limits.maxStorageBlockSize, 2, scenePath);  // children stay in one part
-  planArray(l.triGeom, limits.maxStorageBlockSize, 1, scenePath);
+  // Nodes and TriGeom are read through buffer textures (bvh_textures.*): one buffer each, bounded by
+  // GL_MAX_TEXTURE_BUFFER_SIZE, not by the storage-block size.
+  for (SplitArray* a : {&l.nodes, &l.triGeom}) a->perPart = std::max<std::size_t>(a->count, 1);
   planArray(l.triShade, limits.maxStorageBlockSize, g.triShadeStride, scenePath);
   checkStorageSize(limits, scenePath, "materials", g.materials.size() * sizeof(gpu::Material));
   checkStorageSize(limits, scenePath, "light tree", g.lightTree.nodes.size() * sizeof(gpu::LightNode));

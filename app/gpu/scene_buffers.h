@@ -1,6 +1,7 @@
-// scene_buffers.h — the scene's storage blocks on the GPU: which of the big arrays (BVH nodes, TriGeom,
-// TriShade words) must be split over several blocks because one would exceed
-// GL_MAX_SHADER_STORAGE_BLOCK_SIZE, the shader defines that tell split_buffers.glsl, and the upload.
+// scene_buffers.h — the scene's buffers on the GPU: whether the TriShade words must be split over several
+// storage blocks because one would exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE, the shader defines that tell
+// split_buffers.glsl, and the upload. BVH nodes and TriGeom are one buffer each, read through buffer
+// textures (bvh_textures.*), so the block size does not bound them.
 #pragma once
 #include <cstddef>
 #include <string>

@@ -7,6 +7,27 @@ vec3 permuteToKz(vec3 a, int kz) {
   return kz == 0 ? a.yzx : (kz == 1 ? a.zxy : a);
 }
 
+// The ray-only part of the watertight test (Woop, Benthin, Wald 2013): which axis becomes z, and the
+// shear that maps the direction onto +z. Computed once per ray by the traversal.
+struct RayShear {
+  int kz;    // axis of the largest |dir| component, permuted to z
+  float sx;  // -d.x / d.z of the permuted direction
+  float sy;  // -d.y / d.z
+  float sz;  // 1 / d.z (0 for a zero direction: nothing hits)
+};
+
+RayShear makeRayShear(vec3 dir) {
+  vec3 ad = abs(dir);
+  int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+  vec3 d = permuteToKz(dir, kz);
+  RayShear s;
+  s.kz = kz;
+  s.sz = d.z == 0.0 ? 0.0 : 1.0 / d.z;
+  s.sx = -d.x * s.sz;
+  s.sy = -d.y * s.sz;
+  return s;
+}
+
 // Woop, Benthin, Wald 2013, in the form of pbrt-v4's IntersectTriangle: translate to the ray origin,
 // permute the largest direction component to z, shear the ray onto +z, then 2D edge functions.
 // Shared edges give exactly negated edge functions, so no ray slips between two triangles; `precise`
@@ -14,18 +35,14 @@ vec3 permuteToKz(vec3 a, int kz) {
 // are the barycentric weights of p1 and p2. Degenerate (zero-area) triangles never hit.
 // Difference from the C++ twin: no double-precision recomputation when an edge function is exactly 0
 // (such a ray counts as on the edge, so it may hit both neighbours; watertightness is unaffected).
-bool intersectTriangle(vec3 org, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float tmax,
-                       out float t, out float u, out float v) {
+bool intersectTriangleSheared(vec3 org, RayShear rs, vec3 p0, vec3 p1, vec3 p2, float tmax,
+                              out float t, out float u, out float v) {
   t = 0.0;
   u = 0.0;
   v = 0.0;
-  vec3 ad = abs(dir);
-  int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
-  vec3 d = permuteToKz(dir, kz);
-  if (d.z == 0.0) return false;  // zero direction
-  float sz = 1.0 / d.z;
-  float sx = -d.x * sz;
-  float sy = -d.y * sz;
+  if (rs.sz == 0.0) return false;  // zero direction
+  float sx = rs.sx, sy = rs.sy, sz = rs.sz;
+  int kz = rs.kz;
 
   vec3 a = permuteToKz(p0 - org, kz);
   vec3 b = permuteToKz(p1 - org, kz);
@@ -69,6 +86,12 @@ bool intersectTriangle(vec3 org, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float tmax
   u = e1 * invDet;
   v = e2 * invDet;
   return true;
+}
+
+// The same test for a single ray (its shear computed here).
+bool intersectTriangle(vec3 org, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float tmax,
+                       out float t, out float u, out float v) {
+  return intersectTriangleSheared(org, makeRayShear(dir), p0, p1, p2, tmax, t, u, v);
 }
 
 // Slab test against [bmin, bmax]; invDir comes from safeInverse() (finite: no 0 * inf = NaN).

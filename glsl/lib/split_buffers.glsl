@@ -1,56 +1,19 @@
-// split_buffers.glsl — reads of the big scene arrays (BVH nodes, TriGeom, TriShade words) that also work
-// when one storage block cannot hold an array (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): the host
-// (app/gpu/scene_buffers.*) then splits it into CAUSTICA_<ARRAY>_PARTS parts of CAUSTICA_<ARRAY>_PART
-// elements each and binds part k > 0 at CAUSTICA_<ARRAY>_BINDING<k>. Without those defines (the usual
-// case) each accessor reads its one block. Included by bindings.glsl.
+// split_buffers.glsl — reads of the big per-triangle arrays that also work when one storage block cannot
+// hold them (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): TriGeom comes through its buffer texture (no block
+// limit); the TriShade words, when the host (app/gpu/scene_buffers.*) splits them, come from
+// CAUSTICA_TRISHADE_PARTS blocks of CAUSTICA_TRISHADE_PART words, part k > 0 bound at
+// CAUSTICA_TRISHADE_BINDING<k>. Without those defines (the usual case) triShadeWord reads its one
+// block. The BVH nodes are read through their own buffer texture (traverse.glsl). Included by bindings.glsl.
 
-#ifdef CAUSTICA_NODES_PARTS
-layout(std430, binding = CAUSTICA_NODES_BINDING1) readonly buffer NodeBuffer1 { BvhNode nodes1[]; };
-#if CAUSTICA_NODES_PARTS > 2
-layout(std430, binding = CAUSTICA_NODES_BINDING2) readonly buffer NodeBuffer2 { BvhNode nodes2[]; };
-#endif
-#if CAUSTICA_NODES_PARTS > 3
-layout(std430, binding = CAUSTICA_NODES_BINDING3) readonly buffer NodeBuffer3 { BvhNode nodes3[]; };
-#endif
-BvhNode bvhNode(uint i) {
-  uint part = i / uint(CAUSTICA_NODES_PART);
-  uint j = i - part * uint(CAUSTICA_NODES_PART);
-  if (part == 0u) return nodes[j];
-#if CAUSTICA_NODES_PARTS > 2
-  if (part == 2u) return nodes2[j];
-#endif
-#if CAUSTICA_NODES_PARTS > 3
-  if (part == 3u) return nodes3[j];
-#endif
-  return nodes1[j];
-}
-#else
-BvhNode bvhNode(uint i) { return nodes[i]; }
-#endif
-
-#ifdef CAUSTICA_TRIGEOM_PARTS
-layout(std430, binding = CAUSTICA_TRIGEOM_BINDING1) readonly buffer TriGeomBuffer1 { TriGeom triGeom1[]; };
-#if CAUSTICA_TRIGEOM_PARTS > 2
-layout(std430, binding = CAUSTICA_TRIGEOM_BINDING2) readonly buffer TriGeomBuffer2 { TriGeom triGeom2[]; };
-#endif
-#if CAUSTICA_TRIGEOM_PARTS > 3
-layout(std430, binding = CAUSTICA_TRIGEOM_BINDING3) readonly buffer TriGeomBuffer3 { TriGeom triGeom3[]; };
-#endif
+// TriGeom record i, read through the buffer texture the traversal uses (3 RGBA32UI texels; no SSBO, so
+// no storage-block limit: GL_MAX_TEXTURE_BUFFER_SIZE texels, checked by app/gpu/bvh_textures.cpp).
 TriGeom triGeomAt(uint i) {
-  uint part = i / uint(CAUSTICA_TRIGEOM_PART);
-  uint j = i - part * uint(CAUSTICA_TRIGEOM_PART);
-  if (part == 0u) return triGeom[j];
-#if CAUSTICA_TRIGEOM_PARTS > 2
-  if (part == 2u) return triGeom2[j];
-#endif
-#if CAUSTICA_TRIGEOM_PARTS > 3
-  if (part == 3u) return triGeom3[j];
-#endif
-  return triGeom1[j];
+  TriGeom t;
+  t.v0 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i)));
+  t.v1 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i + 1u)));
+  t.v2 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i + 2u)));
+  return t;
 }
-#else
-TriGeom triGeomAt(uint i) { return triGeom[i]; }
-#endif
 
 #ifdef CAUSTICA_TRISHADE_PARTS
 layout(std430, binding = CAUSTICA_TRISHADE_BINDING1) readonly buffer TriShadeBuffer1 { uint triShadeWords1[]; };

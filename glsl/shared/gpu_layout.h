@@ -18,21 +18,23 @@ using uint = std::uint32_t;
 #endif
 
 // ---- binding indices (macros: GLSL 4.30 layout qualifiers take only literals) -------------------
-#define CAUSTICA_BINDING_NODES 0      // SSBO: BvhNode[]
-#define CAUSTICA_BINDING_TRIGEOM 1    // SSBO: TriGeom[] (reordered to BVH leaf order)
+#define CAUSTICA_BINDING_NODES 0      // buffer of BvhNode[]; the shaders read it through CAUSTICA_TEXUNIT_BVH_NODES, not as an SSBO
+#define CAUSTICA_BINDING_TRIGEOM 1    // buffer of TriGeom[] (BVH leaf order); read through CAUSTICA_TEXUNIT_TRI_GEOM, not as an SSBO
 #define CAUSTICA_BINDING_TRISHADE 2   // SSBO: uint[] shading words per triangle (same order as TriGeom; kTriShadeWords)
 #define CAUSTICA_BINDING_MATERIALS 3  // SSBO: Material[]
 #define CAUSTICA_BINDING_EMITTERS 4   // SSBO: LightNode[] (light tree over emissive triangles)
 #define CAUSTICA_BINDING_TEXELS 5     // SSBO: uint[]: TexInfo records (kTexInfoWords each), then RGBA8 texels, sRGB-encoded
 #define CAUSTICA_BINDING_COUNTERS 6   // SSBO: Counters (atomic statistics)
-#define CAUSTICA_SSBO_COUNT 7         // SSBO bindings the path tracer always uses
+#define CAUSTICA_SSBO_COUNT 7         // buffers the path tracer binds (bindings 0-6; 0 and 1 are read as textures)
 #define CAUSTICA_BINDING_SPLIT_FIRST 7  // first binding of the extra parts of split arrays (split_buffers.glsl)
-#define CAUSTICA_MAX_SPLIT_PARTS 4    // parts an array (nodes, TriGeom, TriShade) may be split into
+#define CAUSTICA_MAX_SPLIT_PARTS 4    // storage blocks the TriShade words may be split into
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
 #define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
 #define CAUSTICA_BINDING_ENVIRONMENT 3  // UBO: EnvironmentParams (environment map size, rotation, background)
 #define CAUSTICA_TEXUNIT_ENV_MAP 0      // texture unit: rgba32f environment map (rgb radiance, a conditional CDF)
 #define CAUSTICA_TEXUNIT_ENV_MARGINAL 1 // texture unit: rgba32f height x 1 (r: marginal CDF over rows)
+#define CAUSTICA_TEXUNIT_BVH_NODES 2   // texture unit: buffer texture (rgba32ui) over the nodes SSBO's buffer, 4 texels per BvhNode
+#define CAUSTICA_TEXUNIT_TRI_GEOM 3    // texture unit: buffer texture (rgba32ui) over the TriGeom buffer, 3 texels per triangle
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
@@ -71,13 +73,27 @@ CAUSTICA_CONST uint kBackgroundColor = 1u;        // EnvironmentParams.backgroun
 CAUSTICA_CONST uint kBackgroundTransparent = 2u;  // nothing: radiance 0 and alpha 0
 
 // ---- SSBO structs ----------------------------------------------------------------------------
-// 32-byte BVH node: bounds and either two children (left, left+1) or a range of triangles.
+// 64-byte BVH node (Aila & Laine 2009 style): the boxes of BOTH children live in the parent, so one
+// node fetch (4 RGBA32UI texels of the texture buffer CAUSTICA_TEXUNIT_BVH_NODES) decides which
+// children a ray enters. nodes[0] is the root. A child reference (left, right) is either an inner
+// node's index (bit 31 clear) or a leaf packed as kBvhLeafBit | count << kBvhCountShift | first
+// triangle (count 1..kBvhMaxLeafSize triangles triGeom[first .. first + count - 1]); an empty slot
+// (empty scene; the second child of a one-leaf tree) is a leaf of count 0, kBvhEmptyRef.
 struct BvhNode {
-  vec3 bmin;        // world-space AABB minimum
-  uint leftFirst;   // inner node: index of the left child (right = left + 1); leaf: first triangle
-  vec3 bmax;        // world-space AABB maximum
-  uint triCount;    // 0 for an inner node, else the number of triangles in the leaf
+  vec3 lmin;      // left child's world-space AABB minimum
+  uint left;      // left child reference
+  vec3 lmax;      // left child's AABB maximum
+  uint reserved0; // 0
+  vec3 rmin;      // right child's AABB minimum
+  uint right;     // right child reference
+  vec3 rmax;      // right child's AABB maximum
+  uint reserved1; // 0
 };
+CAUSTICA_CONST uint kBvhLeafBit = 0x80000000u;
+CAUSTICA_CONST uint kBvhCountShift = 27u;
+CAUSTICA_CONST uint kBvhFirstMask = 0x07ffffffu;  // first triangle of a leaf: < 2^27
+CAUSTICA_CONST uint kBvhMaxLeafSize = 15u;         // 4 bits of count
+CAUSTICA_CONST uint kBvhEmptyRef = 0x80000000u;    // a leaf of no triangles
 
 // Triangle positions for intersection (48 bytes).
 struct TriGeom {
@@ -225,7 +241,7 @@ static_assert(sizeof(PointLight) == 64, "PointLight must be 64 bytes (std140)");
 static_assert(sizeof(PointLights) == 16 + 64 * CAUSTICA_MAX_POINT_LIGHTS, "PointLights must match std140");
 static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
-static_assert(sizeof(BvhNode) == 32, "BvhNode must be 32 bytes (std430)");
+static_assert(sizeof(BvhNode) == 64, "BvhNode must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");

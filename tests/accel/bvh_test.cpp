@@ -195,6 +195,45 @@ std::vector<Triangle> nonFiniteTriangles(int count, Rng& rng) {
   return tris;
 }
 
+// The packed GPU nodes mirror the binary tree: walking both together from the roots, every packed
+// node holds exactly its binary node's two children (boxes bit for bit, leaves as packed refs), every
+// packed node is reached once, and children come after their parent.
+void checkPacked(const Bvh& bvh) {
+  REQUIRE(!bvh.nodes.empty());
+  REQUIRE(bvh.binary.size() >= 1);
+  if (bvh.binary[0].triCount > 0) return;  // one-leaf tree: checked in "empty and single-triangle scenes"
+  auto sameBox = [](glm::vec3 a, glm::vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+  std::vector<int> reached(bvh.nodes.size(), 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};  // (packed, binary)
+  int bad = 0;
+  while (!stack.empty()) {
+    const auto [p, b] = stack.back();
+    stack.pop_back();
+    REQUIRE(p < bvh.nodes.size());
+    reached[p]++;
+    const gpu::BvhNode& n = bvh.nodes[p];
+    const BvhBinaryNode& node = bvh.binary[b];
+    REQUIRE(node.triCount == 0);
+    const std::uint32_t kids[2] = {node.leftFirst, node.leftFirst + 1};
+    const std::uint32_t refs[2] = {n.left, n.right};
+    bad += !sameBox(n.lmin, bvh.binary[kids[0]].bmin) || !sameBox(n.lmax, bvh.binary[kids[0]].bmax);
+    bad += !sameBox(n.rmin, bvh.binary[kids[1]].bmin) || !sameBox(n.rmax, bvh.binary[kids[1]].bmax);
+    bad += n.reserved0 != 0 || n.reserved1 != 0;
+    for (int k = 0; k < 2; ++k) {
+      const BvhBinaryNode& c = bvh.binary[kids[k]];
+      if (c.triCount > 0) {
+        bad += refs[k] != (gpu::kBvhLeafBit | c.triCount << gpu::kBvhCountShift | c.leftFirst);
+      } else {
+        bad += (refs[k] & gpu::kBvhLeafBit) != 0 || refs[k] <= p;
+        stack.push_back({refs[k], kids[k]});
+      }
+    }
+  }
+  CHECK(bad == 0);
+  CHECK(std::count(reached.begin(), reached.end(), 1) == std::ptrdiff_t(bvh.nodes.size()));
+  CHECK(bvh.nodes.size() == std::size_t(bvh.leafCount - 1));  // one per inner node
+}
+
 // Checks the structural invariants of a BVH built over tris.
 void checkStructure(const Bvh& bvh, const std::vector<Triangle>& tris, int maxLeafSize) {
   const std::size_t n = tris.size();
@@ -205,24 +244,24 @@ void checkStructure(const Bvh& bvh, const std::vector<Triangle>& tris, int maxLe
     seen[i]++;
   }
   CHECK(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(n));  // a permutation
-  REQUIRE(!bvh.nodes.empty());
-  CHECK(bvh.nodes.size() == std::size_t(2 * bvh.leafCount - 1));
+  REQUIRE(!bvh.binary.empty());
+  CHECK(bvh.binary.size() == std::size_t(2 * bvh.leafCount - 1));
   CHECK(std::isfinite(bvh.sahCost));
   CHECK(bvh.sahCost >= 0.0f);
 
-  std::vector<int> covered(n, 0), visited(bvh.nodes.size(), 0);
+  std::vector<int> covered(n, 0), visited(bvh.binary.size(), 0);
   struct Item { std::uint32_t node; int depth; };
   std::vector<Item> stack{{0, 1}};
   int maxDepth = 0, leaves = 0, badBox = 0, badChild = 0, badLeaf = 0;
-  auto inside = [](glm::vec3 p, const gpu::BvhNode& b) {
+  auto inside = [](glm::vec3 p, const BvhBinaryNode& b) {
     return p.x >= b.bmin.x && p.y >= b.bmin.y && p.z >= b.bmin.z && p.x <= b.bmax.x && p.y <= b.bmax.y && p.z <= b.bmax.z;
   };
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
-    if (it.node >= bvh.nodes.size() || visited[it.node]++ != 0)  // a tree: every node reached once
+    if (it.node >= bvh.binary.size() || visited[it.node]++ != 0)  // a tree: every node reached once
       FAIL("node " << it.node << " out of range or reached twice");
-    const gpu::BvhNode& node = bvh.nodes[it.node];
+    const BvhBinaryNode& node = bvh.binary[it.node];
     maxDepth = std::max(maxDepth, it.depth);
     if (node.triCount > 0) {
       leaves++;
@@ -234,16 +273,16 @@ void checkStructure(const Bvh& bvh, const std::vector<Triangle>& tris, int maxLe
           if (!inside(p, node)) badBox++;
       }
     } else {
-      if (node.leftFirst <= it.node || std::size_t(node.leftFirst) + 1 >= bvh.nodes.size())
+      if (node.leftFirst <= it.node || std::size_t(node.leftFirst) + 1 >= bvh.binary.size())
         FAIL("bad children of node " << it.node);
       for (std::uint32_t c = node.leftFirst; c <= node.leftFirst + 1; ++c) {
-        const gpu::BvhNode& child = bvh.nodes[c];
+        const BvhBinaryNode& child = bvh.binary[c];
         if (!inside(child.bmin, node) || !inside(child.bmax, node)) badChild++;
         stack.push_back({c, it.depth + 1});
       }
     }
   }
-  CHECK(std::count(visited.begin(), visited.end(), 1) == std::ptrdiff_t(bvh.nodes.size()));
+  CHECK(std::count(visited.begin(), visited.end(), 1) == std::ptrdiff_t(bvh.binary.size()));
   CHECK(std::count(covered.begin(), covered.end(), 1) == std::ptrdiff_t(n));  // leaves partition [0, n)
   CHECK(badBox == 0);
   CHECK(badChild == 0);
@@ -251,6 +290,7 @@ void checkStructure(const Bvh& bvh, const std::vector<Triangle>& tris, int maxLe
   CHECK(leaves == bvh.leafCount);
   CHECK(maxDepth == bvh.depth);
   CHECK(bvh.depth < CAUSTICA_BVH_STACK);
+  checkPacked(bvh);
 }
 
 }  // namespace
@@ -529,8 +569,11 @@ TEST_CASE("bvh: empty and single-triangle scenes") {
   SUBCASE("one triangle") {
     const std::vector<Triangle> tris{makeTriangle({0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 7)};
     const Bvh bvh = buildBvh(tris);
-    REQUIRE(bvh.nodes.size() == 1);
-    CHECK(bvh.nodes[0].triCount == 1);
+    REQUIRE(bvh.binary.size() == 1);
+    CHECK(bvh.binary[0].triCount == 1);
+    REQUIRE(bvh.nodes.size() == 1);  // packed: a root holding the leaf and an empty slot
+    CHECK(bvh.nodes[0].left == (gpu::kBvhLeafBit | 1u << gpu::kBvhCountShift));
+    CHECK(bvh.nodes[0].right == gpu::kBvhEmptyRef);
     const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
     REQUIRE(geom.size() == 1);
     CHECK(glm::floatBitsToUint(geom[0].v0.w) == 7u);

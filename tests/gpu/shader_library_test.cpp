@@ -139,14 +139,14 @@ TEST_CASE("the other entry shaders compile") {
   }
 }
 
-TEST_CASE("split storage blocks (split_buffers.glsl): 2 to 4 parts of every big array compile in both compute modes") {
+TEST_CASE("split storage blocks (split_buffers.glsl): 2 to 4 parts of the TriShade words compile in both compute modes") {
   ShaderLibrary lib;
   for (int parts = 2; parts <= CAUSTICA_MAX_SPLIT_PARTS; ++parts)
     for (const char* entry : {"pathtrace.comp", "whitted.comp"}) {
-      // Bindings as app/gpu/scene_buffers.cpp hands them out: 7, 8, ... in the order nodes, TriGeom, TriShade.
+      // Bindings as app/gpu/scene_buffers.cpp hands them out: 7, 8, ...
       std::vector<std::string> defines = {"CAUSTICA_TEXTURES", "CAUSTICA_MIS", "CAUSTICA_GLASS"};
       int next = CAUSTICA_BINDING_SPLIT_FIRST;
-      for (const char* a : {"CAUSTICA_NODES", "CAUSTICA_TRIGEOM", "CAUSTICA_TRISHADE"}) {
+      for (const char* a : {"CAUSTICA_TRISHADE"}) {
         defines.push_back(std::string(a) + "_PARTS=" + std::to_string(parts));
         defines.push_back(std::string(a) + "_PART=1000u");
         for (int k = 1; k < parts; ++k) defines.push_back(std::string(a) + "_BINDING" + std::to_string(k) + "=" + std::to_string(next++));

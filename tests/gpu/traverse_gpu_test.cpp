@@ -10,6 +10,7 @@
 
 #include "accel/bvh.h"
 #include "accel/spawn.h"
+#include "gpu/bvh_textures.h"
 #include "scene/obj_mesh.h"
 #include "gpu/gl_objects.h"
 #include "gpu/shader_library.h"
@@ -45,7 +46,8 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std
   ExpandedShader src = lib.expand("tests/trace_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
   prog.use();
-  nodes.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_NODES);
+  BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test");
+  textures.bind();
   geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);
   rayBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 8);
   hitBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 9);
