@@ -1,10 +1,14 @@
-// bvh_bench.cpp — benchmark (not a test) of the BVH builder and the C++ traversal: build time, Mtris/s,
-// SAH cost, node/leaf counts and depth, and single-thread traceClosest Mrays/s, for the bunny and a
-// generated displaced sphere of about 1M triangles, over a few (bins, maxLeafSize) choices.
+// bvh_bench.cpp — benchmark (not a test) of the BVH builder and the C++ traversal: build time (wall and
+// CPU), Mtris/s, SAH cost, node/leaf counts and depth, and single-thread traceClosest Mrays/s, for the
+// bunny and a generated displaced sphere of about 1M triangles, over a few (bins, maxLeafSize, threads) choices.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <algorithm>
+#include <chrono>
 #include <ctime>
+#include <thread>
 #include <exception>
 #include <fstream>
 #include <random>
@@ -21,11 +25,12 @@ using namespace caustica;
 namespace {
 
 const char* kUsage =
-    "usage: bvh_bench [--csv FILE] [--help]\n"
+    "usage: bvh_bench [--csv FILE] [--threads N] [--help]\n"
     "Builds BVHs over the bunny (assets/meshes/bunny.obj) and a ~1M-triangle displaced sphere with\n"
     "several (bins, maxLeafSize) settings and prints build time, Mtris/s, SAH cost, nodes, leaves,\n"
-    "depth and single-thread traceClosest speed on random rays (times are CPU time; builds best of\n"
-    "several). --csv FILE also writes the table.\n";
+    "depth and single-thread traceClosest speed on random rays (builds: best of several, wall time\n"
+    "and CPU time of all threads; Mtris/s from wall time). --threads N builds with 1 and N threads\n"
+    "(default: the hardware's count). --csv FILE also writes the table.\n";
 
 
 // UV sphere of radius ~1 with a bumpy displacement: 2 * nu * (nv - 1) triangles (one per pole cell).
@@ -54,8 +59,8 @@ double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 struct Row {
   std::string mesh;
   std::size_t tris;
-  int bins, leaf;
-  double buildMs, mtris, sah;
+  int bins, leaf, threads;
+  double buildMs, cpuMs, mtris, sah;
   std::size_t nodes;
   int leaves, depth;
   double mrays, hitFraction;
@@ -80,24 +85,30 @@ std::vector<Ray> randomRays(const std::vector<Triangle>& tris, int count) {
   return rays;
 }
 
+double wallSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 Row measure(const std::string& name, const std::vector<Triangle>& tris, const std::vector<Ray>& rays, int bins,
-            int leaf, int repeats) {
+            int leaf, int threads, int repeats) {
   BvhBuildOptions opt;
   opt.bins = bins;
   opt.maxLeafSize = leaf;
+  opt.threads = threads;
   Bvh bvh;
-  double best = 1e30;
+  double best = 1e30, bestCpu = 1e30;
   for (int k = 0; k < repeats; ++k) {  // best of `repeats` builds
-    const double t0 = cpuSeconds();
+    const double t0 = wallSeconds(), c0 = cpuSeconds();
     bvh = buildBvh(tris, opt);
-    best = std::min(best, cpuSeconds() - t0);
+    best = std::min(best, wallSeconds() - t0);
+    bestCpu = std::min(bestCpu, cpuSeconds() - c0);
   }
   const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
   std::size_t hits = 0;
   const double t0 = cpuSeconds();
   for (const Ray& r : rays) hits += traceClosest(bvh.nodes, geom, r).found();
   const double traceS = cpuSeconds() - t0;
-  return {name,         tris.size(),          bins,       leaf, best * 1e3, double(tris.size()) / best * 1e-6,
+  return {name,         tris.size(),          bins,       leaf, threads, best * 1e3, bestCpu * 1e3, double(tris.size()) / best * 1e-6,
           bvh.sahCost,  bvh.nodes.size(),     bvh.leafCount, bvh.depth, double(rays.size()) / traceS * 1e-6,
           double(hits) / double(rays.size())};
 }
@@ -106,12 +117,19 @@ Row measure(const std::string& name, const std::vector<Triangle>& tris, const st
 
 int main(int argc, char** argv) {
   std::string csvPath;
+  int threads = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
       std::fputs(kUsage, stdout);
       return 0;
     } else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) {
       csvPath = argv[++i];
+    } else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
+      threads = std::atoi(argv[++i]);
+      if (threads < 1) {
+        std::fprintf(stderr, "bvh_bench: --threads must be >= 1\n");
+        return 2;
+      }
     } else {
       std::fprintf(stderr, "bvh_bench: unknown argument '%s'\n%s", argv[i], kUsage);
       return 2;
@@ -128,25 +146,31 @@ int main(int argc, char** argv) {
     meshes.push_back({"sphere1M", displacedSphere(1024, 512), 100000, 3});
 
     std::vector<Row> rows;
-    std::printf("%-9s %9s %4s %4s %9s %8s %8s %9s %8s %5s %8s %5s\n", "mesh", "tris", "bins", "leaf", "build_ms",
-                "Mtris/s", "SAH", "nodes", "leaves", "depth", "Mrays/s", "hit%");
+    std::printf("%-9s %9s %4s %4s %3s %9s %9s %8s %8s %9s %8s %5s %8s %5s\n", "mesh", "tris", "bins", "leaf", "thr",
+                "build_ms", "cpu_ms", "Mtris/s", "SAH", "nodes", "leaves", "depth", "Mrays/s", "hit%");
     for (const Mesh& m : meshes) {
       const std::vector<Ray> rays = randomRays(m.tris, m.rays);
       for (int bins : {8, 16, 32})
-        for (int leaf : {1, 2, 4, 8}) {
-          const Row r = measure(m.name, m.tris, rays, bins, leaf, m.repeats);
-          std::printf("%-9s %9zu %4d %4d %9.2f %8.2f %8.2f %9zu %8d %5d %8.3f %5.1f\n", r.mesh.c_str(), r.tris, r.bins,
-                      r.leaf, r.buildMs, r.mtris, r.sah, r.nodes, r.leaves, r.depth, r.mrays, 100.0 * r.hitFraction);
-          std::fflush(stdout);
-          rows.push_back(r);
-        }
+        for (int leaf : {1, 2, 4, 8})
+          for (int thr : {1, threads}) {
+            if (thr == threads && threads == 1 && !rows.empty() && rows.back().threads == 1 && rows.back().leaf == leaf &&
+                rows.back().bins == bins && rows.back().mesh == m.name)
+              continue;  // --threads 1: one row per setting
+            const Row r = measure(m.name, m.tris, rays, bins, leaf, thr, m.repeats);
+            std::printf("%-9s %9zu %4d %4d %3d %9.2f %9.2f %8.2f %8.2f %9zu %8d %5d %8.3f %5.1f\n", r.mesh.c_str(), r.tris,
+                        r.bins, r.leaf, r.threads, r.buildMs, r.cpuMs, r.mtris, r.sah, r.nodes, r.leaves, r.depth, r.mrays,
+                        100.0 * r.hitFraction);
+            std::fflush(stdout);
+            rows.push_back(r);
+          }
     }
     if (!csvPath.empty()) {
       std::ofstream csv(csvPath);
       if (!csv) throw Error(csvPath + ": cannot write");
-      csv << "mesh,tris,bins,max_leaf,build_ms,mtris_per_s,sah_cost,nodes,leaves,depth,mrays_per_s,hit_fraction\n";
+      csv << "mesh,tris,bins,max_leaf,threads,build_ms,cpu_ms,mtris_per_s,sah_cost,nodes,leaves,depth,mrays_per_s,hit_fraction\n";
       for (const Row& r : rows)
-        csv << r.mesh << ',' << r.tris << ',' << r.bins << ',' << r.leaf << ',' << r.buildMs << ',' << r.mtris << ','
+        csv << r.mesh << ',' << r.tris << ',' << r.bins << ',' << r.leaf << ',' << r.threads << ',' << r.buildMs << ','
+            << r.cpuMs << ',' << r.mtris << ','
             << r.sah << ',' << r.nodes << ',' << r.leaves << ',' << r.depth << ',' << r.mrays << ',' << r.hitFraction
             << '\n';
     }

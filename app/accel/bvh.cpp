@@ -4,6 +4,10 @@
 #include "accel/bvh.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <string>
 
@@ -136,63 +140,59 @@ Box triangleBox(const Triangle& tri) {
 
 }  // namespace
 
-Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
-  if (options.bins < 2 || options.bins > kMaxBins)
-    throw Error("bvh.cpp: BvhBuildOptions::bins must be in [2, " + std::to_string(kMaxBins) + "]");
-  if (options.maxLeafSize < 1 || options.maxLeafSize > int(gpu::kBvhMaxLeafSize))
-    throw Error("bvh.cpp: BvhBuildOptions::maxLeafSize must be in [1, " + std::to_string(gpu::kBvhMaxLeafSize) + "]");
-  if (triangles.size() > std::size_t(gpu::kBvhFirstMask))
-    throw Error("bvh.cpp: too many triangles (" + std::to_string(triangles.size()) + ")");
+namespace {
 
-  Bvh bvh;
-  const std::uint32_t n = std::uint32_t(triangles.size());
-  const int bins = options.bins;
-  const std::uint32_t maxLeaf = std::uint32_t(options.maxLeafSize);
-  const double ct = options.costTraversal, ci = options.costIntersect;
+// Shared state of one build: the prims (each subtree owns a disjoint range), the node array (sized for
+// the largest possible tree; each subtree writes only the nodes it allocates) and the next free node.
+struct BuildContext {
+  std::vector<Prim>& prims;
+  std::vector<BvhBinaryNode>& nodes;
+  std::atomic<std::uint32_t> nextNode{1};
+  int bins = 16;
+  std::uint32_t maxLeaf = 4;
+  double ct = 1.0, ci = 1.0;
+  double rootArea = 1.0;
+  bool rootAreaOk = false;
+};
 
-  if (n == 0) {  // one empty node with an inverted box: traversal rejects it before reading children
-    BvhBinaryNode empty{};
-    empty.bmin = glm::vec3(kInf);
-    empty.bmax = glm::vec3(-kInf);
-    bvh.binary.push_back(empty);
-    bvh.depth = 1;
-    bvh.leafCount = 1;
-    bvh.nodes = packBvhNodes(bvh.binary);
-    return bvh;
-  }
+// Depth, leaf count and SAH cost (relative to the root's area) of a built part of the tree.
+struct BuildStats {
+  int depth = 0;
+  int leafCount = 0;
+  double sah = 0.0;
+};
 
-  std::vector<Prim> prims;
-  prims.reserve(n);
-  for (std::uint32_t i = 0; i < n; ++i) prims.emplace_back(triangleBox(triangles[i]), i);
-
-  bvh.binary.reserve(2 * std::size_t(n));
-  bvh.binary.emplace_back();
-  std::vector<WorkItem> work;
-  work.push_back({0, 0, n, 1, Box{}, Box{}});
-  boundsOfRange(prims, 0, n, work.back().box, work.back().cbox);
-  const double rootArea = work.back().box.halfArea();
-  const bool rootAreaOk = rootArea > 0.0 && std::isfinite(rootArea);
-  double sah = 0.0;  // SAH cost relative to the root's area
-
+// Builds the subtree of `root` depth-first. With `deferred`, nodes of fewer than deferBelow prims are
+// not built but appended to it (their node slots and prim ranges are already theirs).
+void buildSubtree(BuildContext& ctx, const WorkItem& root, BuildStats& st, std::vector<WorkItem>* deferred,
+                  std::uint32_t deferBelow) {
+  const int bins = ctx.bins;
+  const std::uint32_t maxLeaf = ctx.maxLeaf;
+  const double ct = ctx.ct, ci = ctx.ci;
+  std::vector<WorkItem> work{root};
   Bin binsPerAxis[3][kMaxBins];  // kept empty between nodes
   const F4 lastBin = splat(float(bins - 1));
   while (!work.empty()) {
     const WorkItem item = work.back();
     work.pop_back();
+    if (deferred && item.count < deferBelow) {  // left for the parallel phase
+      deferred->push_back(item);
+      continue;
+    }
     const double nodeArea = item.box.halfArea();
-    const double relArea = rootAreaOk ? nodeArea / rootArea : 1.0;
-    BvhBinaryNode& out = bvh.binary[item.node];
+    const double relArea = ctx.rootAreaOk ? nodeArea / ctx.rootArea : 1.0;
+    BvhBinaryNode& out = ctx.nodes[item.node];
     out.bmin = glm::vec3(item.box.lo[0], item.box.lo[1], item.box.lo[2]);
     out.bmax = glm::vec3(item.box.hi[0], item.box.hi[1], item.box.hi[2]);
 
     auto makeLeaf = [&]() {
       if (item.count > maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
-      BvhBinaryNode& leaf = bvh.binary[item.node];
+      BvhBinaryNode& leaf = ctx.nodes[item.node];
       leaf.leftFirst = item.first;
       leaf.triCount = item.count;
-      bvh.leafCount++;
-      bvh.depth = std::max(bvh.depth, item.depth);
-      sah += ci * double(item.count) * relArea;
+      st.leafCount++;
+      st.depth = std::max(st.depth, item.depth);
+      st.sah += ci * double(item.count) * relArea;
     };
     if (item.count == 1 || item.depth >= kMaxLeafDepth) {
       makeLeaf();
@@ -213,7 +213,7 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     Split best;
     if (anyAxis) {
       for (std::uint32_t i = item.first; i < item.first + item.count; ++i) {
-        const Prim& p = prims[i];
+        const Prim& p = ctx.prims[i];
         const I4 b = binsOf(centroidOf(p), item.cbox.lo, scale, lastBin);
         for (int a = 0; a < 3; ++a) {  // flat axes all land in bin 0 and are ignored below
           Bin& bin = binsPerAxis[a][b[a]];
@@ -271,15 +271,15 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
       // In-place partition; child bounds come from the prims themselves, so they are exact.
       std::uint32_t i = item.first, j = item.first + item.count;
       while (i < j) {
-        const F4 c = centroidOf(prims[i]);
+        const F4 c = centroidOf(ctx.prims[i]);
         if (binsOf(c, item.cbox.lo, scale, lastBin)[best.axis] < best.pos) {
-          left.box.grow(prims[i].box);
+          left.box.grow(ctx.prims[i].box);
           left.cbox.grow(c);
           ++i;
         } else {
           --j;
-          std::swap(prims[i], prims[j]);
-          right.box.grow(prims[j].box);
+          std::swap(ctx.prims[i], ctx.prims[j]);
+          right.box.grow(ctx.prims[j].box);
           right.cbox.grow(c);
         }
       }
@@ -291,25 +291,106 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
       for (int k = 1; k < 3; ++k)
         if (item.cbox.hi[k] - item.cbox.lo[k] > item.cbox.hi[a] - item.cbox.lo[a]) a = k;
       left.count = item.count / 2;
-      Prim* begin = prims.data() + item.first;
+      Prim* begin = ctx.prims.data() + item.first;
       std::nth_element(begin, begin + left.count, begin + item.count,
                        [a](const Prim& p, const Prim& q) { return centroidOf(p)[a] < centroidOf(q)[a]; });
-      boundsOfRange(prims, item.first, left.count, left.box, left.cbox);
-      boundsOfRange(prims, item.first + left.count, item.count - left.count, right.box, right.cbox);
+      boundsOfRange(ctx.prims, item.first, left.count, left.box, left.cbox);
+      boundsOfRange(ctx.prims, item.first + left.count, item.count - left.count, right.box, right.cbox);
     }
     right.first = item.first + left.count;
     right.count = item.count - left.count;
 
-    left.node = std::uint32_t(bvh.binary.size());
+    left.node = ctx.nextNode.fetch_add(2);
     right.node = left.node + 1;
-    bvh.binary[item.node].leftFirst = left.node;
-    bvh.binary[item.node].triCount = 0;
-    bvh.binary.emplace_back();
-    bvh.binary.emplace_back();
-    sah += ct * relArea;
+    ctx.nodes[item.node].leftFirst = left.node;
+    ctx.nodes[item.node].triCount = 0;
+    st.sah += ct * relArea;
     work.push_back(right);
     work.push_back(left);
   }
+
+}
+
+}  // namespace
+
+Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
+  if (options.bins < 2 || options.bins > kMaxBins)
+    throw Error("bvh.cpp: BvhBuildOptions::bins must be in [2, " + std::to_string(kMaxBins) + "]");
+  if (options.maxLeafSize < 1 || options.maxLeafSize > int(gpu::kBvhMaxLeafSize))
+    throw Error("bvh.cpp: BvhBuildOptions::maxLeafSize must be in [1, " + std::to_string(gpu::kBvhMaxLeafSize) + "]");
+  if (options.threads < 0) throw Error("bvh.cpp: BvhBuildOptions::threads must be >= 0");
+  if (triangles.size() > std::size_t(gpu::kBvhFirstMask))
+    throw Error("bvh.cpp: too many triangles (" + std::to_string(triangles.size()) + ")");
+
+  Bvh bvh;
+  const std::uint32_t n = std::uint32_t(triangles.size());
+
+  if (n == 0) {  // one empty node with an inverted box; packed as a root of two empty slots
+    BvhBinaryNode empty{};
+    empty.bmin = glm::vec3(kInf);
+    empty.bmax = glm::vec3(-kInf);
+    bvh.binary.push_back(empty);
+    bvh.depth = 1;
+    bvh.leafCount = 1;
+    bvh.nodes = packBvhNodes(bvh.binary);
+    return bvh;
+  }
+
+  std::vector<Prim> prims;
+  prims.reserve(n);
+  for (std::uint32_t i = 0; i < n; ++i) prims.emplace_back(triangleBox(triangles[i]), i);
+
+  bvh.binary.resize(2 * std::size_t(n) - 1);  // the most nodes a binary tree over n prims can have
+  BuildContext ctx{prims, bvh.binary};
+  ctx.bins = options.bins;
+  ctx.maxLeaf = std::uint32_t(options.maxLeafSize);
+  ctx.ct = options.costTraversal;
+  ctx.ci = options.costIntersect;
+  WorkItem root{0, 0, n, 1, Box{}, Box{}};
+  boundsOfRange(prims, 0, n, root.box, root.cbox);
+  ctx.rootArea = root.box.halfArea();
+  ctx.rootAreaOk = ctx.rootArea > 0.0 && std::isfinite(ctx.rootArea);
+
+  // The top of the tree on this thread, down to subtrees of fewer than n / (8 * threads) prims; those
+  // are then built by `threads` threads, largest first. Every subtree owns its prim range and the
+  // nodes it allocates, so the tree (shape, boxes, leaf order) is the one a single thread builds; only
+  // the binary node numbering depends on scheduling, and packBvhNodes renumbers depth-first.
+  unsigned threads = options.threads > 0 ? unsigned(options.threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (n < 65536) threads = 1;  // small meshes: starting threads costs more than it saves
+  BuildStats top;
+  std::vector<WorkItem> deferred;
+  buildSubtree(ctx, root, top, threads > 1 ? &deferred : nullptr, std::max<std::uint32_t>(1, n / (8 * threads)));
+  std::sort(deferred.begin(), deferred.end(), [](const WorkItem& x, const WorkItem& y) {
+    return x.count != y.count ? x.count > y.count : x.first < y.first;
+  });
+  std::vector<BuildStats> stats(deferred.size());
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failureMutex;
+  auto worker = [&]() {
+    try {
+      for (std::size_t k = next.fetch_add(1); k < deferred.size(); k = next.fetch_add(1))
+        buildSubtree(ctx, deferred[k], stats[k], nullptr, 0);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failureMutex);
+      if (!failure) failure = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads && !deferred.empty(); ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+
+  double sah = top.sah;
+  bvh.depth = top.depth;
+  bvh.leafCount = top.leafCount;
+  for (const BuildStats& st : stats) {  // in a fixed order, so the sum does not depend on scheduling
+    sah += st.sah;
+    bvh.depth = std::max(bvh.depth, st.depth);
+    bvh.leafCount += st.leafCount;
+  }
+  bvh.binary.resize(ctx.nextNode.load());
 
   if (bvh.depth >= CAUSTICA_BVH_STACK)
     throw Error("bvh.cpp: BVH depth " + std::to_string(bvh.depth) + " exceeds the traversal stack");

@@ -16,6 +16,7 @@ struct BvhBuildOptions {
   int maxLeafSize = 4;      // leaves never hold more triangles than this (at most gpu::kBvhMaxLeafSize)
   float costTraversal = 1.0f;   // SAH cost of visiting an inner node
   float costIntersect = 1.0f;   // SAH cost of one ray-triangle test
+  int threads = 0;          // build threads; 0: one per hardware thread (meshes under 65,536 triangles use one)
 };
 
 // A node of the builder's binary tree (32 bytes): its own box and either two children (leftFirst,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -610,4 +611,26 @@ TEST_CASE("bvh: packTriGeom follows the leaf order; bad options throw") {
   opt.maxLeafSize = 0;
   CHECK_THROWS_AS(buildBvh(tris, opt), Error);
   CHECK_THROWS_AS(packTriGeom(std::vector<Triangle>(3), bvh), Error);
+}
+
+TEST_CASE("bvh: a threaded build gives the single-threaded tree") {
+  // Above 65,536 triangles the build runs subtrees on threads; the tree must not depend on that.
+  Rng rng(21);
+  const std::vector<Triangle> tris = randomSoup(120000, rng);
+  BvhBuildOptions one;
+  one.threads = 1;
+  const Bvh a = buildBvh(tris, one);
+  for (int threads : {2, 3, 8}) {
+    BvhBuildOptions many;
+    many.threads = threads;
+    const Bvh b = buildBvh(tris, many);
+    CHECK(b.order == a.order);
+    REQUIRE(b.nodes.size() == a.nodes.size());
+    CHECK(std::memcmp(b.nodes.data(), a.nodes.data(), a.nodes.size() * sizeof(gpu::BvhNode)) == 0);
+    CHECK(b.depth == a.depth);
+    CHECK(b.leafCount == a.leafCount);
+    CHECK(b.binary.size() == a.binary.size());
+    CHECK(b.sahCost == doctest::Approx(a.sahCost).epsilon(1e-6));  // summed in another order
+    checkStructure(b, tris, BvhBuildOptions{}.maxLeafSize);
+  }
 }
