@@ -132,9 +132,22 @@ void Renderer::prepareMode() {
   }
 }
 
+namespace {
+// Every material feature define, for RenderSettings::allFeatures (the unspecialised shader).
+std::vector<std::string> allMaterialFeatureDefines() {
+  SceneFeatures f;
+  f.mirror = f.glass = f.volume = f.dispersion = f.textures = f.opacity = true;
+  f.environment = f.punctual = f.spotEmitters = f.ggx = true;
+  return f.defines();
+}
+}  // namespace
+
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
-  for (const std::string& split : bufferLayout_.defines()) d.push_back(split);  // split_buffers.glsl
+  if (settings_.allFeatures && settings_.mode == RenderMode::Path) d = allMaterialFeatureDefines();
+  // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
+  // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
+  for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");

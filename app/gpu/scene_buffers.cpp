@@ -49,6 +49,7 @@ void uploadArray(std::vector<T>& v, const SplitArray& a, int binding, std::vecto
 
 std::vector<std::string> SceneBufferLayout::defines() const {
   std::vector<std::string> d;
+  if (texcoords) d.push_back("CAUSTICA_TRISHADE_TEXCOORDS");
   for (const SplitArray* a : {&nodes, &triGeom, &triShade}) {
     if (a->parts < 2) continue;
     const std::string key = a == &nodes ? "CAUSTICA_NODES" : a == &triGeom ? "CAUSTICA_TRIGEOM" : "CAUSTICA_TRISHADE";
@@ -74,6 +75,7 @@ SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, co
   l.triShade = {"triangle shading data", 4, g.triangleCount * g.triShadeStride, 0, 1, {}};
   // Nodes and TriGeom are read through buffer textures (bvh_textures.*): one buffer each, bounded by
   // GL_MAX_TEXTURE_BUFFER_SIZE, not by the storage-block size.
+  l.texcoords = g.triShadeStride == gpu::kTriShadeWordsTextured;
   for (SplitArray* a : {&l.nodes, &l.triGeom}) a->perPart = std::max<std::size_t>(a->count, 1);
   planArray(l.triShade, limits.maxStorageBlockSize, g.triShadeStride, scenePath);
   checkStorageSize(limits, scenePath, "materials", g.materials.size() * sizeof(gpu::Material));

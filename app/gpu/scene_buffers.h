@@ -24,8 +24,9 @@ struct SplitArray {
 
 struct SceneBufferLayout {
   SplitArray nodes, triGeom, triShade;
-  // CAUSTICA_<ARRAY>_PARTS=n, _PART=elements, _BINDING<k>=index for each split array; none when no
-  // array is split (then the shaders are the usual variant).
+  bool texcoords = false;  // the TriShade words hold texcoords (kTriShadeWordsTextured per triangle)
+  // CAUSTICA_TRISHADE_TEXCOORDS when the words hold texcoords; CAUSTICA_<ARRAY>_PARTS=n,
+  // _PART=elements, _BINDING<k>=index for each split array (none when no array is split).
   std::vector<std::string> defines() const;
   int extraBlocks() const { return nodes.parts + triGeom.parts + triShade.parts - 3; }
   std::string describe() const;  // e.g. "one block per array" or "triangles in 2 blocks"

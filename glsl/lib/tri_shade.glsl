@@ -3,7 +3,9 @@
 // Needs bindings.glsl.
 #include "oct_normal.glsl"
 
-#ifdef CAUSTICA_TEXTURES
+// CAUSTICA_TRISHADE_TEXCOORDS (app/gpu/scene_buffers.cpp): the words hold texcoords, which the host
+// stores exactly when the scene has textures (CAUSTICA_TEXTURES alone may come from --all-features).
+#ifdef CAUSTICA_TRISHADE_TEXCOORDS
 const uint kShadeStride = kTriShadeWordsTextured;
 #else
 const uint kShadeStride = kTriShadeWords;
@@ -19,7 +21,7 @@ void triNormals(uint tri, out vec3 n0, out vec3 n1, out vec3 n2) {
 
 // Vertex texcoords of triangle `tri` (the material's UV set); (0,0) in scenes without textures.
 void triUvs(uint tri, out vec2 t0, out vec2 t1, out vec2 t2) {
-#ifdef CAUSTICA_TEXTURES
+#ifdef CAUSTICA_TRISHADE_TEXCOORDS
   uint base = tri * kShadeStride + 3u;
   t0 = uintBitsToFloat(uvec2(triShadeWord(base), triShadeWord(base + 1u)));
   t1 = uintBitsToFloat(uvec2(triShadeWord(base + 2u), triShadeWord(base + 3u)));

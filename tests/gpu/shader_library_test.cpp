@@ -144,7 +144,7 @@ TEST_CASE("split storage blocks (split_buffers.glsl): 2 to 4 parts of the TriSha
   for (int parts = 2; parts <= CAUSTICA_MAX_SPLIT_PARTS; ++parts)
     for (const char* entry : {"pathtrace.comp", "whitted.comp"}) {
       // Bindings as app/gpu/scene_buffers.cpp hands them out: 7, 8, ...
-      std::vector<std::string> defines = {"CAUSTICA_TEXTURES", "CAUSTICA_MIS", "CAUSTICA_GLASS"};
+      std::vector<std::string> defines = {"CAUSTICA_TEXTURES", "CAUSTICA_TRISHADE_TEXCOORDS", "CAUSTICA_MIS", "CAUSTICA_GLASS"};
       int next = CAUSTICA_BINDING_SPLIT_FIRST;
       for (const char* a : {"CAUSTICA_TRISHADE"}) {
         defines.push_back(std::string(a) + "_PARTS=" + std::to_string(parts));
