@@ -104,8 +104,11 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_VOLUME
     beta *= exp(-sigma * hit.t);
 #endif
-    TriGeom g = triGeom[hit.tri];
-    TriShade s = triShade[hit.tri];
+    TriGeom g = triGeomAt(hit.tri);
+    vec3 sn0, sn1, sn2;
+    vec2 st0, st1, st2;
+    triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
+    triUvs(hit.tri, st0, st1, st2);
     float b0 = 1.0 - hit.u - hit.v;
     vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
     vec3 pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);  // spawn.glsl
@@ -115,15 +118,14 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     vec3 ngFront = cr / crLen;              // geometric normal of the front (counter-clockwise) face
     bool front = dot(dir, ngFront) < 0.0;
     vec3 ng = front ? ngFront : -ngFront;   // geometric normal on the side the ray came from
-    vec3 nsRaw = b0 * s.n0.xyz + hit.u * s.n1.xyz + hit.v * s.n2.xyz;
+    vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
     float nsLen = length(nsRaw);
     vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
     if (dot(ns, ngFront) < 0.0) ns = -ns;
-    vec2 uv = b0 * vec2(s.n0.w, s.vt.x) + hit.u * vec2(s.n1.w, s.vt.y) + hit.v * vec2(s.n2.w, s.vt.z);
+    vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
     Material m = materials[floatBitsToUint(g.v0.w)];
 #ifdef CAUSTICA_TEXTURES
-    ns = applyNormalMap(m, ns, uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, vec2(s.n0.w, s.vt.x), vec2(s.n1.w, s.vt.y),
-                        vec2(s.n2.w, s.vt.z));
+    ns = applyNormalMap(m, ns, uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
 #endif
     if (!front) ns = -ns;                   // shading normal on the side the ray came from
 

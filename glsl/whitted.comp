@@ -53,7 +53,7 @@ void pushRay(vec3 org, vec3 dir, vec3 weight, vec3 sigma, uint depth) {
 // Any hit with 0 < t < tmax that is not an emitter: the point lights stand in for the emissive
 // triangles, which therefore cast no shadows (a light's centre may lie inside its closed mesh).
 // traceOccluded with whittedOccluder as its filter (traverse.glsl, CAUSTICA_OCCLUDER_FILTER).
-bool whittedOccluder(uint tri) { return !isEmissive(materials[floatBitsToUint(triGeom[tri].v0.w)]); }
+bool whittedOccluder(uint tri) { return !isEmissive(materials[floatBitsToUint(triGeomAt(tri).v0.w)]); }
 bool occludedByNonEmitter(vec3 org, vec3 dir, float tmax) { return traceOccluded(org, dir, tmax); }
 
 // Direct light from every point light at p, with a sharp shadow ray each (radiance towards wv).
@@ -98,8 +98,11 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_VOLUME
     w *= exp(-r.sigma * hit.t);
 #endif
-    TriGeom g = triGeom[hit.tri];
-    TriShade s = triShade[hit.tri];
+    TriGeom g = triGeomAt(hit.tri);
+    vec3 sn0, sn1, sn2;
+    vec2 st0, st1, st2;
+    triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
+    triUvs(hit.tri, st0, st1, st2);
     float b0 = 1.0 - hit.u - hit.v;
     vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
     vec3 pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);
@@ -109,12 +112,12 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
     vec3 ngFront = cr / crLen;
     bool front = dot(r.dir, ngFront) < 0.0;
     vec3 ng = front ? ngFront : -ngFront;
-    vec3 nsRaw = b0 * s.n0.xyz + hit.u * s.n1.xyz + hit.v * s.n2.xyz;
+    vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
     float nsLen = length(nsRaw);
     vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
     if (dot(ns, ngFront) < 0.0) ns = -ns;
     if (!front) ns = -ns;
-    vec2 uv = b0 * vec2(s.n0.w, s.vt.x) + hit.u * vec2(s.n1.w, s.vt.y) + hit.v * vec2(s.n2.w, s.vt.z);
+    vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
     Material m = materials[floatBitsToUint(g.v0.w)];
 
     if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) radiance += w * materialEmission(m, uv);

@@ -7,6 +7,7 @@
 #include "scene/caustic_casters.h"
 #include "util/error.h"
 #include "shading/microfacet.h"
+#include "shading/oct_normal.h"
 #include "shading/sampling.h"
 
 namespace caustica {
@@ -137,23 +138,40 @@ void packEnvironment(const Scene& scene, GpuScene& g) {
 }
 }  // namespace
 
-GpuScene packScene(const Scene& scene, const Bvh& bvh) {
+void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, std::size_t first, std::size_t count,
+                       std::vector<gpu::TriGeom>& geom, std::vector<std::uint32_t>& shade) {
+  if (first + count > bvh.order.size() || g.lightTree.leafOf.size() != bvh.order.size())
+    throw Error("internal: packTriangleRange outside the BVH's triangles");
+  geom.resize(count);
+  shade.resize(count * g.triShadeStride);
+  for (std::size_t j = 0; j < count; ++j) {
+    const std::size_t i = first + j;
+    const Triangle& t = scene.triangles[bvh.order[i]];
+    const std::uint32_t leaf = g.lightTree.leafOf[i];
+    geom[j].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
+    geom[j].v1 = glm::vec4(t.p[1], glm::uintBitsToFloat(leaf == gpu::kInvalidIndex ? 0u : leaf + 1u));
+    geom[j].v2 = glm::vec4(t.p[2], 0.0f);
+    // Shading words (gpu_layout.h): octahedral normals, then full-float texcoords only where textures
+    // read them (half floats would move a texel on large textures).
+    std::uint32_t* w = shade.data() + j * g.triShadeStride;
+    for (int k = 0; k < 3; ++k) w[k] = octEncode(t.n[k]);
+    if (g.triShadeStride == gpu::kTriShadeWordsTextured)
+      for (int k = 0; k < 3; ++k) {
+        w[3 + 2 * k] = floatBits(t.uv[k].x);
+        w[4 + 2 * k] = floatBits(t.uv[k].y);
+      }
+  }
+}
+
+GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   GpuScene g;
   g.features = sceneFeatures(scene);
   g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
   g.emitterSphere = emitterBoundingSphere(scene);
   packEnvironment(scene, g);
   g.nodes = bvh.nodes;
-  g.triGeom = packTriGeom(scene.triangles, bvh);
-  g.triShade.resize(bvh.order.size());
-  for (size_t i = 0; i < bvh.order.size(); ++i) {
-    const Triangle& t = scene.triangles[bvh.order[i]];
-    gpu::TriShade& s = g.triShade[i];
-    s.n0 = glm::vec4(t.n[0], t.uv[0].x);
-    s.n1 = glm::vec4(t.n[1], t.uv[1].x);
-    s.n2 = glm::vec4(t.n[2], t.uv[2].x);
-    s.vt = glm::vec4(t.uv[0].y, t.uv[1].y, t.uv[2].y, 0.0f);
-  }
+  g.triangleCount = bvh.order.size();
+  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
 
   for (const Material& m : scene.materials) {
     gpu::Material gm{};
@@ -214,11 +232,12 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
   std::vector<std::uint32_t> tris;
   double totalWeight = 0.0;
   std::vector<LightTreeItem> lightItems;
-  for (size_t i = 0; i < g.triGeom.size(); ++i) {
-    const Material& m = scene.materials[scene.triangles[bvh.order[i]].material];
+  for (size_t i = 0; i < g.triangleCount; ++i) {
+    const Triangle& tri = scene.triangles[bvh.order[i]];
+    const Material& m = scene.materials[tri.material];
     if (!m.isEmissive()) continue;
-    const gpu::TriGeom& t = g.triGeom[i];
-    double area = 0.5 * glm::length(glm::cross(glm::vec3(t.v1) - glm::vec3(t.v0), glm::vec3(t.v2) - glm::vec3(t.v0)));
+    const glm::vec3* t = tri.p;  // TriGeom's vertices
+    double area = 0.5 * glm::length(glm::cross(t[1] - t[0], t[2] - t[0]));
     double w = static_cast<double>(luminance(glm::max(m.emission, glm::vec3(0.0f)))) * area * (m.doubleSided ? 2.0 : 1.0);
     if (!(w > 0.0) || !std::isfinite(w)) continue;
     weights.push_back(w);
@@ -226,22 +245,42 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh) {
     totalWeight += w;
     LightTreeItem item;
     item.tri = static_cast<std::uint32_t>(i);
-    item.v[0] = glm::vec3(t.v0);
-    item.v[1] = glm::vec3(t.v1);
-    item.v[2] = glm::vec3(t.v2);
+    item.v[0] = t[0];
+    item.v[1] = t[1];
+    item.v[2] = t[2];
     item.power = w;
     item.twoSided = m.doubleSided;
     lightItems.push_back(item);
   }
   // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
-  // TriShade.vt.w (leaf index + 1 as uint bits, 0: not in the tree).
-  g.lightTree = buildLightTree(std::move(lightItems), g.triGeom.size());
-  for (size_t i = 0; i < g.triShade.size(); ++i)
-    g.triShade[i].vt.w = glm::uintBitsToFloat(g.lightTree.leafOf[i] == gpu::kInvalidIndex ? 0u : g.lightTree.leafOf[i] + 1u);
+  // TriGeom.v1.w (leaf index + 1 as uint bits, 0: not in the tree).
+  g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
+  if (triangleArrays) packTriangleRange(scene, bvh, g, 0, g.triangleCount, g.triGeom, g.triShade);
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
   g.emitters = buildAliasTable(weights, tris);
   return g;
+}
+
+glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k) {
+  return octDecode(g.triShade[tri * g.triShadeStride + static_cast<std::size_t>(k)]);
+}
+
+glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k) {
+  if (g.triShadeStride != gpu::kTriShadeWordsTextured) return glm::vec2(0.0f);
+  const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + 3 + 2 * k;
+  return glm::vec2(glm::uintBitsToFloat(w[0]), glm::uintBitsToFloat(w[1]));
+}
+
+GpuSceneBytes gpuSceneBytes(const GpuScene& g) {
+  GpuSceneBytes b;
+  b.nodes = g.nodes.size() * sizeof(gpu::BvhNode);
+  b.triGeom = g.triangleCount * sizeof(gpu::TriGeom);
+  b.triShade = g.triangleCount * g.triShadeStride * 4;
+  b.materials = g.materials.size() * sizeof(gpu::Material);
+  b.lightTree = g.lightTree.nodes.size() * sizeof(gpu::LightNode);
+  b.textures = (g.texels.size() + g.texInfo.size() * gpu::kTexInfoWords) * 4;
+  return b;
 }
 
 }  // namespace caustica

@@ -30,8 +30,10 @@ bool hasRoughLobe(const Material& m);
 
 struct GpuScene {
   std::vector<gpu::BvhNode> nodes;
+  std::size_t triangleCount = 0;        // triangles (TriGeom records), also when triGeom is not filled
   std::vector<gpu::TriGeom> triGeom;    // BVH leaf order
-  std::vector<gpu::TriShade> triShade;  // BVH leaf order
+  std::vector<std::uint32_t> triShade;  // BVH leaf order, triShadeStride words per triangle (gpu_layout.h)
+  std::uint32_t triShadeStride = gpu::kTriShadeWords;  // kTriShadeWordsTextured when features.textures
   std::vector<gpu::Material> materials;
   std::vector<gpu::Emitter> emitters;   // alias table, one slot per emissive triangle (host only: counts, info)
   LightTree lightTree;                  // light tree over the same triangles: what the shaders sample (binding 4)
@@ -48,7 +50,25 @@ struct GpuScene {
   gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
 };
 
-GpuScene packScene(const Scene& scene, const Bvh& bvh);
+// `triangleArrays` false leaves triGeom and triShade empty: the Renderer packs and uploads them in
+// slices (packTriangleRange), so the host never holds them whole.
+GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays = true);
+// TriGeom records and TriShade words of triangles [first, first + count) (BVH leaf order) of a scene
+// packed by packScene (it needs g.lightTree.leafOf and g.triShadeStride), into geom and shade.
+void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, std::size_t first, std::size_t count,
+                       std::vector<gpu::TriGeom>& geom, std::vector<std::uint32_t>& shade);
+
+// Vertex k's shading normal (unit, or zero where the mesh has none) and texcoord of triangle `tri`
+// (BVH leaf order) as the shaders decode them from GpuScene::triShade (tri_shade.glsl).
+glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k);
+glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k);  // (0, 0) in scenes without textures
+
+// What the scene occupies on the GPU, in bytes, by storage block (gpu/renderer.cpp uploads these).
+struct GpuSceneBytes {
+  std::size_t nodes = 0, triGeom = 0, triShade = 0, materials = 0, lightTree = 0, textures = 0;
+  std::size_t total() const { return nodes + triGeom + triShade + materials + lightTree + textures; }
+};
+GpuSceneBytes gpuSceneBytes(const GpuScene& g);
 
 // Vose's alias table over `weights` (non-negative, not all zero). Slot i holds item `items[i]`.
 std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items);

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "cli/cli_common.h"
+#include "cli/load_report.h"
 #include "cli/commands.h"
 #include "cli/environment_options.h"
 #include "accel/bvh.h"
@@ -45,13 +46,17 @@ int cmdInfo(const std::vector<std::string>& args) {
                specs);
   if (!opts.parse(args)) return 0;
   if (opts.positional().empty()) throw Error("info needs a scene (a .gltf/.glb file or a bundled scene name)");
+  auto t0 = std::chrono::steady_clock::now();
   LoadedScene ls = loadSceneForCli(opts, true);
   const Scene& s = ls.scene;
+  const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  auto t0 = std::chrono::steady_clock::now();
+  t0 = std::chrono::steady_clock::now();
   Bvh bvh = buildBvh(s.triangles);
   double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  t0 = std::chrono::steady_clock::now();
   GpuScene g = packScene(s, bvh);
+  const double packSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   std::printf("scene:      %s\n", s.path.c_str());
   std::printf("triangles:  %zu\n", s.triangles.size());
@@ -91,6 +96,10 @@ int cmdInfo(const std::vector<std::string>& args) {
               s.cameras.size());
   std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
               bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
+  std::printf("memory:     %s; %s\n", gpuBytesSummary(gpuSceneBytes(g), s.triangles.size()).c_str(),
+              hostPeakSummary(s.triangles.size()).c_str());
+  std::printf("load:       parse %.2f s, BVH %.2f s, pack %.2f s (upload and first sample: render's load line)\n",
+              parseSeconds, buildSeconds, packSeconds);
   std::printf("features:   %s\n", g.features.describe().c_str());
   if (g.casters.empty()) std::printf("casters:    none (no glass or mirror object)\n");
   for (size_t i = 0; i < g.casters.size(); ++i)

@@ -10,6 +10,7 @@
 #include "cli/budget_render.h"
 #include "cli/checkpoint.h"
 #include "cli/cli_common.h"
+#include "cli/load_report.h"
 #include "cli/commands.h"
 #include "util/error.h"
 #include "util/file_io.h"
@@ -74,7 +75,9 @@ int cmdRender(const std::vector<std::string>& args) {
   const std::string resumePath = opts.get("--resume", "");
   if (opts.has("--resume")) resumeFrom = readCheckpoint(resumePath);  // a bad file fails before any work
 
+  const auto commandStart = std::chrono::steady_clock::now();
   LoadedScene ls = loadSceneForCli(opts, !quiet);
+  const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
@@ -89,6 +92,7 @@ int cmdRender(const std::vector<std::string>& args) {
   auto context = createHeadlessContext(backend, &glInfo);
   note(quiet, "OpenGL (" + context->backendName() + "): " + glInfo);
   ShaderLibrary library = shaderLibraryFrom(opts);
+  const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
                   std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
@@ -122,6 +126,7 @@ int cmdRender(const std::vector<std::string>& args) {
   std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s, non-finite samples: %llu", total,
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
+  note(quiet, loadSummary(renderer, parseSeconds, startToRenderer, ls.scene.triangles.size()));  // load_report.h
   writeImage(out, renderer.image(), tone);
   {
     const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);

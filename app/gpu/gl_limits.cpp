@@ -22,6 +22,12 @@ GlLimits queryGlLimits() {
     if (cap > 0 && cap < l.maxStorageBlockSize) l.maxStorageBlockSize = cap;
   }
   glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &l.maxComputeStorageBlocks);
+  glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &l.maxStorageBufferBindings);
+  // CAUSTICA_MAX_SSBO_BLOCKS lowers the block count, e.g. to the 8 GL 4.3 guarantees (tests).
+  if (const char* env = std::getenv("CAUSTICA_MAX_SSBO_BLOCKS")) {
+    long long cap = std::atoll(env);
+    if (cap > 0 && cap < l.maxComputeStorageBlocks) l.maxComputeStorageBlocks = static_cast<int>(cap);
+  }
   glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &l.maxWorkGroupInvocations);
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.maxTextureSize);
   glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &l.maxWorkGroupCount[0]);

@@ -9,7 +9,8 @@ namespace caustica {
 
 struct GlLimits {
   std::int64_t maxStorageBlockSize = 0;  // bytes per SSBO (lowered by $CAUSTICA_MAX_SSBO_BYTES)
-  int maxComputeStorageBlocks = 0;
+  int maxComputeStorageBlocks = 0;   // (lowered by $CAUSTICA_MAX_SSBO_BLOCKS)
+  int maxStorageBufferBindings = 0;  // GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS
   int maxWorkGroupInvocations = 0;
   int maxTextureSize = 0;
   int maxWorkGroupCount[2] = {0, 0};

@@ -54,9 +54,11 @@ GlBuffer GlBuffer::create(std::size_t bytes, const void* data, GLenum usage) {
     std::copy_n(static_cast<const unsigned char*>(data), bytes, padded.begin());
     glBufferData(GL_COPY_WRITE_BUFFER, 16, padded.data(), usage);
   }
-  if (!data) {
-    std::vector<unsigned char> zeros(b.size_, 0);
-    glBufferSubData(GL_COPY_WRITE_BUFFER, 0, static_cast<GLsizeiptr>(b.size_), zeros.data());
+  if (!data) {  // zeros, in slices of at most 4 MiB (a big scene's blocks are filled in slices too)
+    std::vector<unsigned char> zeros(std::min<std::size_t>(b.size_, std::size_t(4) << 20), 0);
+    for (std::size_t at = 0; at < b.size_; at += zeros.size())
+      glBufferSubData(GL_COPY_WRITE_BUFFER, static_cast<GLintptr>(at),
+                      static_cast<GLsizeiptr>(std::min(zeros.size(), b.size_ - at)), zeros.data());
   }
   glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
   checkGlError("buffer creation");

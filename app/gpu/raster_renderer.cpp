@@ -94,10 +94,9 @@ RasterMesh buildRasterMesh(const GpuScene& scene) {
 
   auto emit = [&](size_t i) {
     const auto& g = scene.triGeom[i];
-    const auto& s = scene.triShade[i];
     const glm::vec3 p[3] = {glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2)};
-    const glm::vec3 nn[3] = {glm::vec3(s.n0), glm::vec3(s.n1), glm::vec3(s.n2)};
-    const glm::vec2 uv[3] = {{s.n0.w, s.vt.x}, {s.n1.w, s.vt.y}, {s.n2.w, s.vt.z}};
+    const glm::vec3 nn[3] = {shadeNormal(scene, i, 0), shadeNormal(scene, i, 1), shadeNormal(scene, i, 2)};
+    const glm::vec2 uv[3] = {shadeUv(scene, i, 0), shadeUv(scene, i, 1), shadeUv(scene, i, 2)};
     for (int k = 0; k < 3; ++k) {
       glm::vec3 ns = glm::length(nn[k]) > 0.5f ? glm::normalize(nn[k]) : geomNormal[i];
       mesh.vertices.push_back({p[k], ns, uv[k], geomNormal[i]});

@@ -73,52 +73,62 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
 
+  created_ = std::chrono::steady_clock::now();
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   auto t0 = std::chrono::steady_clock::now();
   bvh_ = buildBvh(scene.triangles);
-  bvhSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  gpuScene_ = packScene(scene, bvh_);
+  bvhSeconds_ = load_.bvh = since(t0);
+  t0 = std::chrono::steady_clock::now();
+  std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
+  bvh_.nodes.clear();
+  gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
+  gpuScene_.nodes = std::move(nodes);
+  std::vector<BvhBinaryNode>().swap(bvh_.binary);  // the builder's tree: the GPU nodes were made from it
+  load_.pack = since(t0);
 
-  const GpuScene& g = gpuScene_;
-  checkStorageSize(limits_, scene.path, "BVH nodes", g.nodes.size() * sizeof(gpu::BvhNode));
-  checkStorageSize(limits_, scene.path, "triangles", g.triShade.size() * sizeof(gpu::TriShade));
-  checkStorageSize(limits_, scene.path, "materials", g.materials.size() * sizeof(gpu::Material));
-  checkStorageSize(limits_, scene.path, "light tree", g.lightTree.nodes.size() * sizeof(gpu::LightNode));
-  checkStorageSize(limits_, scene.path, "textures", g.texels.size() * 4);
-
-  buffers_.resize(CAUSTICA_SSBO_COUNT);
-  buffers_[CAUSTICA_BINDING_NODES] = GlBuffer::fromVector(g.nodes);
-  buffers_[CAUSTICA_BINDING_TRIGEOM] = GlBuffer::fromVector(g.triGeom);
-  buffers_[CAUSTICA_BINDING_TRISHADE] = GlBuffer::fromVector(g.triShade);
-  buffers_[CAUSTICA_BINDING_MATERIALS] = GlBuffer::fromVector(g.materials);
-  buffers_[CAUSTICA_BINDING_EMITTERS] = GlBuffer::fromVector(g.lightTree.nodes);
-  buffers_[CAUSTICA_BINDING_TEXELS] = GlBuffer::fromVector(g.texels);
-  buffers_[CAUSTICA_BINDING_TEXINFO] = GlBuffer::fromVector(g.texInfo);
-  buffers_[CAUSTICA_BINDING_COUNTERS] = GlBuffer::create(sizeof(gpu::Counters), nullptr, GL_DYNAMIC_READ);
-  bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], g.nodes.size(), buffers_[CAUSTICA_BINDING_TRIGEOM],
-                             g.triGeom.size(), scene.path);
-  frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
-  casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
-  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
-  uploadCasters();
-  lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
+  GpuScene& g = gpuScene_;
   Bounds sceneBounds;
   glm::vec3 bvhLo, bvhHi;
   if (bvhBounds(g.nodes, bvhLo, bvhHi)) {
     sceneBounds.grow(bvhLo);
     sceneBounds.grow(bvhHi);
   }
+  bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
+  gpuBytes_ = gpuSceneBytes(g);
+  t0 = std::chrono::steady_clock::now();
+  uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
+  bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
+                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path);
+  // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
+  std::vector<std::uint32_t>().swap(bvh_.order);
+  std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
+  frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
+  casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
+  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
+  uploadCasters();
+  lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
   pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
   environment_.upload(g, limits_, scene.path);
+  glFinish();
+  load_.upload = since(t0);
   allocateImages();
+  t0 = std::chrono::steady_clock::now();
   prepareMode();  // compile now, so shader errors surface before rendering starts
+  load_.compile = since(t0);
+  load_.ready = since(created_);
 }
 
 void Renderer::prepareMode() {
   if (settings_.mode != RenderMode::Raster) {
     program();
   } else if (!raster_) {
+    downloadSceneArrays(gpuScene_, bufferLayout_, buffers_);  // the raster mesh is built from them
     raster_ = std::make_unique<RasterRenderer>(library_, gpuScene_, pointLights_);
+    std::vector<gpu::TriGeom>().swap(gpuScene_.triGeom);
+    std::vector<std::uint32_t>().swap(gpuScene_.triShade);
   }
 }
 
@@ -135,6 +145,9 @@ std::vector<std::string> allMaterialFeatureDefines() {
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
   if (settings_.allFeatures && settings_.mode == RenderMode::Path) d = allMaterialFeatureDefines();
+  // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
+  // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
+  for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
@@ -328,7 +341,8 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   }
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   checkGlError("path tracing dispatch");
-  readCounters();
+  readCounters();  // waits for the dispatches
+  if (load_.firstPass == 0.0) load_.firstPass = std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count();
 }
 
 void Renderer::endPass(int spp) {

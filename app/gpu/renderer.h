@@ -1,6 +1,7 @@
 // renderer.h — the progressive path tracer on the GPU: uploads a scene, compiles the shader variant
 // it needs, dispatches samples into the accumulation image and reads results back. Knows no window.
 #pragma once
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -16,6 +17,7 @@
 #include "image/image_io.h"
 #include "scene/scene.h"
 #include "gpu/render_settings.h"
+#include "gpu/scene_buffers.h"
 #include "gpu/shader_library.h"
 #include "image/error_estimate.h"
 #include "image/tonemap.h"
@@ -45,6 +47,13 @@ struct AccumulationState {
   std::vector<float> accum;     // rgba32f running sums (rgb radiance, a = sample count), width*height*4
   std::vector<float> comp;      // rgba32f Kahan compensation terms of those sums, width*height*4
   std::vector<float> half;      // rgba32f sums of each pixel's odd-numbered samples (rgb) and their count (a)
+};
+
+// Seconds the Renderer spent getting a scene ready (docs/benchmarks.md, "Big scenes").
+struct LoadTimes {
+  double bvh = 0.0, pack = 0.0, upload = 0.0, compile = 0.0;
+  double ready = 0.0;        // from the start of the constructor to its end: the first sample can start
+  double firstPass = 0.0;    // from the start of the constructor to the end of the first pass (0: none yet)
 };
 
 class Renderer {
@@ -91,6 +100,10 @@ class Renderer {
   const GpuScene& gpuScene() const { return gpuScene_; }
   const Bvh& bvh() const { return bvh_; }
   double bvhBuildSeconds() const { return bvhSeconds_; }
+  const LoadTimes& loadTimes() const { return load_; }
+  // The scene's storage blocks: bytes by array (measured before the host copies were freed) and split.
+  const GpuSceneBytes& gpuBytes() const { return gpuBytes_; }
+  const SceneBufferLayout& bufferLayout() const { return bufferLayout_; }
   std::vector<std::string> shaderDefines() const;  // the variant the current settings need
   // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
@@ -108,7 +121,11 @@ class Renderer {
   Camera camera_;
   Bvh bvh_;
   double bvhSeconds_ = 0.0;
-  GpuScene gpuScene_;
+  GpuScene gpuScene_;  // nodes, triGeom and triShade are freed once uploaded (only the GPU holds them)
+  LoadTimes load_;
+  std::chrono::steady_clock::time_point created_;
+  GpuSceneBytes gpuBytes_;
+  SceneBufferLayout bufferLayout_;
   GlLimits limits_;
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
   BvhTextures bvhTextures_;  // the traversal's views of the nodes and TriGeom buffers

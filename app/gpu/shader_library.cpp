@@ -114,7 +114,10 @@ std::string ShaderLibrary::read(const std::string& path) const {
 ExpandedShader ShaderLibrary::expand(const std::string& entry, const std::vector<std::string>& defines) const {
   ExpandedShader out;
   out.source = "#version 430 core\n";
-  for (const auto& d : defines) out.source += "#define " + d + " 1\n";
+  for (const auto& d : defines) {  // NAME, or NAME=VALUE (split_buffers.glsl's sizes and bindings)
+    const std::size_t eq = d.find('=');
+    out.source += eq == std::string::npos ? "#define " + d + " 1\n" : "#define " + d.substr(0, eq) + " " + d.substr(eq + 1) + "\n";
+  }
   Expander ex{*this, out, {}};
   ex.expandFile(normalizePath("", entry), "");
   return out;

@@ -146,7 +146,7 @@ class SceneBuilder {
   void traverse();  // fills cameraInstances_ and meshInstances_
   // Refuses a scene whose mesh instances declare more than options_.maxTriangles triangles (from
   // accessor counts), before any accessor is decoded.
-  void checkTriangleCount() const;
+  void checkTriangleCount();  // also reserves the triangles
   // The world-space point (scene units, double) that becomes the float origin: for a scene farther
   // from the world origin than its size, the centre of the meshes' bounds from their POSITION
   // accessors' min/max (node origins where those are missing); else 0.

@@ -16,9 +16,9 @@ struct LightSample {
 // order): the tree's choice probability from p (normal n) over the triangle's area. 0 for a triangle
 // outside the tree. p, n: the shading point and normal that light sampling used there.
 float lightPdfArea(uint tri, vec3 p, vec3 n) {
-  uint leaf = floatBitsToUint(triShade[tri].vt.w);  // leaf index + 1; 0: not in the tree
+  TriGeom g = triGeomAt(tri);
+  uint leaf = floatBitsToUint(g.v1.w);  // leaf index + 1; 0: not in the tree
   if (leaf == 0u) return 0.0;
-  TriGeom g = triGeom[tri];
   float area = 0.5 * length(cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz));
   return area > 0.0 ? lightTreePdf(p, n, leaf - 1u) / area : 0.0;
 }
@@ -30,7 +30,7 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   uint tri;
   float pmf;
   if (!sampleLightTree(p, n, uSelect, tri, pmf)) return false;
-  TriGeom g = triGeom[tri];
+  TriGeom g = triGeomAt(tri);
   vec2 b = sampleTriangleUniform(uTri);
   ls.p = (1.0 - b.x - b.y) * g.v0.xyz + b.x * g.v1.xyz + b.y * g.v2.xyz;
   ls.pError = hitPointError(1.0 - b.x - b.y, b.x, b.y, g.v0.xyz, g.v1.xyz, g.v2.xyz);
@@ -42,8 +42,9 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   Material m = materials[ls.material];
   vec2 uv = vec2(0.0);
 #ifdef CAUSTICA_TEXTURES
-  TriShade s = triShade[tri];
-  uv = (1.0 - b.x - b.y) * vec2(s.n0.w, s.vt.x) + b.x * vec2(s.n1.w, s.vt.y) + b.y * vec2(s.n2.w, s.vt.z);
+  vec2 t0, t1, t2;
+  triUvs(tri, t0, t1, t2);  // tri_shade.glsl
+  uv = (1.0 - b.x - b.y) * t0 + b.x * t1 + b.y * t2;
 #endif
   ls.le = materialEmission(m, uv);
   ls.pdfArea = pmf / (0.5 * len);

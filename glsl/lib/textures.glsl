@@ -26,7 +26,7 @@ vec4 fetchTexel(TexInfo info, int x, int y, bool srgb) {
 }
 
 vec4 sampleTextureAs(uint index, vec2 uv, bool srgb) {
-  TexInfo info = texInfo[index];
+  TexInfo info = texInfoAt(index);  // split_buffers.glsl
   uv = vec2(dot(info.uvRow0.xyz, vec3(uv, 1.0)), dot(info.uvRow1.xyz, vec3(uv, 1.0)));  // KHR_texture_transform
   // Keep the coordinate bounded before converting to int (huge uv would overflow).
   vec2 st = uv * vec2(float(info.width), float(info.height));

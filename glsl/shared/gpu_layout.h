@@ -19,14 +19,15 @@ using uint = std::uint32_t;
 
 // ---- binding indices (macros: GLSL 4.30 layout qualifiers take only literals) -------------------
 #define CAUSTICA_BINDING_NODES 0      // buffer of BvhNode[]; the shaders read it through CAUSTICA_TEXUNIT_BVH_NODES, not as an SSBO
-#define CAUSTICA_BINDING_TRIGEOM 1    // SSBO: TriGeom[] (reordered to BVH leaf order)
-#define CAUSTICA_BINDING_TRISHADE 2   // SSBO: TriShade[] (same order as TriGeom)
+#define CAUSTICA_BINDING_TRIGEOM 1    // buffer of TriGeom[] (BVH leaf order); read through CAUSTICA_TEXUNIT_TRI_GEOM, not as an SSBO
+#define CAUSTICA_BINDING_TRISHADE 2   // SSBO: uint[] shading words per triangle (same order as TriGeom; kTriShadeWords)
 #define CAUSTICA_BINDING_MATERIALS 3  // SSBO: Material[]
 #define CAUSTICA_BINDING_EMITTERS 4   // SSBO: LightNode[] (light tree over emissive triangles)
-#define CAUSTICA_BINDING_TEXELS 5     // SSBO: uint[] RGBA8 texels of all textures, sRGB-encoded
-#define CAUSTICA_BINDING_TEXINFO 6    // SSBO: TexInfo[]
-#define CAUSTICA_BINDING_COUNTERS 7   // SSBO: Counters (atomic statistics)
-#define CAUSTICA_SSBO_COUNT 8         // SSBO bindings used by the path tracer
+#define CAUSTICA_BINDING_TEXELS 5     // SSBO: uint[]: TexInfo records (kTexInfoWords each), then RGBA8 texels, sRGB-encoded
+#define CAUSTICA_BINDING_COUNTERS 6   // SSBO: Counters (atomic statistics)
+#define CAUSTICA_SSBO_COUNT 7         // buffers the path tracer binds (bindings 0-6; 0 and 1 are read as textures)
+#define CAUSTICA_BINDING_SPLIT_FIRST 7  // first binding of the extra parts of split arrays (split_buffers.glsl)
+#define CAUSTICA_MAX_SPLIT_PARTS 4    // storage blocks the TriShade words may be split into
 #define CAUSTICA_BINDING_FRAME 0      // UBO: FrameParams
 #define CAUSTICA_BINDING_CASTERS 1    // UBO: CasterParams (a UBO: GL 4.3 guarantees only 8 SSBOs per shader)
 #define CAUSTICA_BINDING_ENVIRONMENT 3  // UBO: EnvironmentParams (environment map size, rotation, background)
@@ -97,17 +98,20 @@ CAUSTICA_CONST uint kBvhEmptyRef = 0x80000000u;    // a leaf of no triangles
 // Triangle positions for intersection (48 bytes).
 struct TriGeom {
   vec4 v0;  // xyz: vertex 0 (world space); w: material index (stored as float bits of a uint)
-  vec4 v1;  // xyz: vertex 1; w unused
+  vec4 v1;  // xyz: vertex 1; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0
   vec4 v2;  // xyz: vertex 2; w unused
 };
 
-// Triangle shading attributes (64 bytes), fetched only for the closest hit.
-struct TriShade {
-  vec4 n0;  // xyz: vertex normal 0 (world space, unit); w: u of texcoord 0
-  vec4 n1;  // xyz: vertex normal 1; w: u of texcoord 1
-  vec4 n2;  // xyz: vertex normal 2; w: u of texcoord 2
-  vec4 vt;  // x,y,z: v of texcoords 0,1,2; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0
-};
+// Triangle shading attributes, fetched only for the closest hit (glsl/lib/tri_shade.glsl): the TriShade
+// SSBO is a uint[] with kTriShadeWords words per triangle, kTriShadeWordsTextured in scenes with textures
+// (CAUSTICA_TEXTURES), in TriGeom order:
+//   words 0..2: vertex normals 0..2 (world space, unit), octahedral, packSnorm2x16 (octEncode);
+//               kOctZeroNormal: no normal (the geometric normal is used)
+//   words 3..8 (textured scenes only): texcoords u0, v0, u1, v1, u2, v2 (float bits)
+// 12 bytes per triangle without textures (was 64), 36 with.
+CAUSTICA_CONST uint kTriShadeWords = 3u;
+CAUSTICA_CONST uint kTriShadeWordsTextured = 9u;
+CAUSTICA_CONST uint kOctZeroNormal = 0x80008000u;  // snorm -32768 twice: never produced by octEncode
 
 // Material after the glTF material contract (docs/materials.md), 112 bytes.
 struct Material {
@@ -129,15 +133,18 @@ struct Emitter {
   float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
 };
 
-// A texture inside the texel SSBO (48 bytes). Several may share texels (KHR_texture_transform).
+// A texture inside the texel SSBO (48 bytes, stored as kTexInfoWords uints at the head of that SSBO).
+// Several may share texels (KHR_texture_transform).
 struct TexInfo {
-  uint offset;   // first texel in the texel SSBO
+  uint offset;   // first texel in the texel SSBO (GpuScene::texels; the SSBO adds the records in front)
   uint width;    // texels
   uint height;   // texels
   uint flags;    // bit 0: repeat S (else clamp), bit 1: repeat T, bit 2: mirrored S, bit 3: mirrored T, bit 4: nearest filter
   vec4 uvRow0;   // xyz: u' = dot(xyz, (u, v, 1)) (KHR_texture_transform; identity (1, 0, 0)); w unused
   vec4 uvRow1;   // xyz: v' = dot(xyz, (u, v, 1)) (identity (0, 1, 0)); w unused
 };
+
+CAUSTICA_CONST uint kTexInfoWords = 12u;
 
 // Statistics the shader writes atomically.
 struct Counters {
@@ -236,7 +243,6 @@ static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std1
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 64, "BvhNode must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
-static_assert(sizeof(TriShade) == 64, "TriShade must be 64 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
 static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");

@@ -10,6 +10,7 @@
 #include "../lib/materials.glsl"
 #include "../lib/casters.glsl"
 #include "../lib/punctual.glsl"  // without CAUSTICA_PUNCTUAL: spotFalloff only (no UBO)
+#include "../lib/oct_normal.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -52,6 +53,7 @@ const uint kGgxSampleVisibleNormal = 23u;
 const uint kBsdfEvalPdf = 24u;
 const uint kBsdfSample = 25u;
 const uint kSpotFalloff = 26u;
+const uint kOctDecode = 27u;
 
 // The Bsdf of records for kBsdfEvalPdf and kBsdfSample: a[0].w = alpha, a[1].w = eta,
 // a[2] = (color, lobe), a[3].xy = (f0 grey, f90).
@@ -116,6 +118,8 @@ void main() {
     o[0] = bits(offsetRayOrigin(a[0].xyz, a[2].xyz, a[1].xyz), 0.0);
   } else if (function == kHitPointError) {  // a[0].xyz = (b0, b1, b2), a[1..3].xyz = p0, p1, p2
     o[0] = bits(hitPointError(a[0].x, a[0].y, a[0].z, a[1].xyz, a[2].xyz, a[3].xyz), 0.0);
+  } else if (function == kOctDecode) {  // a[0].x: the word (uint)
+    o[0] = bits(octDecode(floatBitsToUint(a[0].x)), 0.0);
   } else if (function == kSpotFalloff) {  // a[0].xyz = (cos theta, cos outer, cos inner)
     o[0].x = floatBitsToUint(spotFalloff(a[0].x, a[0].y, a[0].z));
   } else if (function == kSampleDielectric) {  // a[0] = (d, eta), a[1] = (n, u)

@@ -13,6 +13,7 @@
 
 #include "util/error.h"
 #include "gpu/shader_library.h"
+#include "shared/gpu_layout.h"
 
 using namespace caustica;
 namespace fs = std::filesystem;
@@ -136,6 +137,24 @@ TEST_CASE("the other entry shaders compile") {
     INFO(entry);
     CHECK_MESSAGE(log.empty(), log);
   }
+}
+
+TEST_CASE("split storage blocks (split_buffers.glsl): 2 to 4 parts of the TriShade words compile in both compute modes") {
+  ShaderLibrary lib;
+  for (int parts = 2; parts <= CAUSTICA_MAX_SPLIT_PARTS; ++parts)
+    for (const char* entry : {"pathtrace.comp", "whitted.comp"}) {
+      // Bindings as app/gpu/scene_buffers.cpp hands them out: 7, 8, ...
+      std::vector<std::string> defines = {"CAUSTICA_TEXTURES", "CAUSTICA_TRISHADE_TEXCOORDS", "CAUSTICA_MIS", "CAUSTICA_GLASS"};
+      int next = CAUSTICA_BINDING_SPLIT_FIRST;
+      for (const char* a : {"CAUSTICA_TRISHADE"}) {
+        defines.push_back(std::string(a) + "_PARTS=" + std::to_string(parts));
+        defines.push_back(std::string(a) + "_PART=1000u");
+        for (int k = 1; k < parts; ++k) defines.push_back(std::string(a) + "_BINDING" + std::to_string(k) + "=" + std::to_string(next++));
+      }
+      const std::string log = validate(lib.expand(entry, defines));
+      INFO(entry << " in " << parts << " parts");
+      CHECK_MESSAGE(log.empty(), log);
+    }
 }
 
 // Compiles and links a vertex + fragment pair (the raster mode's programs) with glslang.
