@@ -75,6 +75,8 @@ int cmdRender(const std::vector<std::string>& args) {
   if (opts.has("--resume")) resumeFrom = readCheckpoint(resumePath);  // a bad file fails before any work
 
   LoadedScene ls = loadSceneForCli(opts, !quiet);
+  if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
+    throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
