@@ -189,3 +189,55 @@ TEST_CASE("light tree: leaves stay within the 32-bit trail on a geometric progre
   for (std::uint32_t i = 0; i < 200; ++i) sum += lightTreePdf(t.nodes, p, glm::vec3(0, 1, 0), t.leafOf[i]);
   CHECK(std::abs(sum + deadEndMass(t.nodes, p, glm::vec3(0, 1, 0)) - 1.0) <= 1e-4);
 }
+
+TEST_CASE("light tree, flat fast path: tiny trees are sampled by power, sum to 1, pmf == pdf, chi-square") {
+  // At most CAUSTICA_LIGHT_FLAT_MAX triangles: no descent, the choice is by power alone from anywhere.
+  REQUIRE(CAUSTICA_LIGHT_FLAT_MAX >= 2);
+  CHECK_FALSE(lightTreeIsFlat(buildLightTree(randomLights(CAUSTICA_LIGHT_FLAT_MAX + 1, 9), 64).nodes));
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), pos(-7.0f, 7.0f);
+  for (int n = 1; n <= CAUSTICA_LIGHT_FLAT_MAX; ++n) {
+    CAPTURE(n);
+    auto items = randomLights(n, 20 + n);
+    LightTree t = buildLightTree(items, 64);
+    REQUIRE(lightTreeIsFlat(t.nodes));
+    double total = 0.0;
+    for (const auto& it : items) total += it.power;
+    // Every triangle's probability is its share of the power, wherever the point (even behind it).
+    for (int k = 0; k < 20; ++k) {
+      glm::vec3 p(pos(rng), pos(rng), pos(rng)), nrm = randomDir(rng);
+      double sum = 0.0;
+      for (const auto& it : items) {
+        const float pdf = lightTreePdf(t.nodes, p, nrm, t.leafOf[it.tri]);
+        CHECK(pdf == doctest::Approx(it.power / total).epsilon(1e-5));
+        sum += pdf;
+      }
+      CHECK(std::abs(sum - 1.0) <= 1e-5);
+      std::uint32_t tri;
+      float pmf;
+      REQUIRE(sampleLightTree(t.nodes, p, nrm, unit(rng), tri, pmf));
+      CHECK(pmf == lightTreePdf(t.nodes, p, nrm, t.leafOf[tri]));  // the same arithmetic: exactly equal
+    }
+    // Sampled frequencies against the pdf (n - 1 degrees of freedom; 1e-4 quantile below mean + 5.5 sd,
+    // loosely, for so few cells), 200,000 draws; u = 1 - 2^-24 still picks a triangle.
+    const int samples = 200000;
+    std::vector<double> count(t.nodes.size(), 0.0);
+    for (int s = 0; s < samples; ++s) {
+      std::uint32_t tri;
+      float pmf;
+      REQUIRE(sampleLightTree(t.nodes, glm::vec3(0.0f), glm::vec3(0.0f), unit(rng), tri, pmf));
+      count[t.leafOf[tri]] += 1.0;
+    }
+    double chi2 = 0.0;
+    for (const auto& it : items) {
+      const double e = samples * it.power / total, o = count[t.leafOf[it.tri]];
+      chi2 += (o - e) * (o - e) / e;
+    }
+    const int dof = std::max(n - 1, 1);
+    INFO("chi2 ", chi2, " with ", dof, " degrees of freedom");
+    CHECK(chi2 <= dof + 5.5 * std::sqrt(2.0 * dof) + 10.0);
+    std::uint32_t tri;
+    float pmf;
+    CHECK(sampleLightTree(t.nodes, glm::vec3(0.0f), glm::vec3(0.0f), 0x1.fffffep-1f, tri, pmf));
+  }
+}
