@@ -251,40 +251,8 @@ float lightImportance(const gpu::LightNode& node, const glm::vec3& p, const glm:
   return std::max(importance, 0.0f);
 }
 
-bool lightTreeIsFlat(const std::vector<gpu::LightNode>& nodes) {
-  return nodes.size() + 1u <= 2u * static_cast<std::size_t>(CAUSTICA_LIGHT_FLAT_MAX);
-}
-
-bool sampleLightFlat(const std::vector<gpu::LightNode>& nodes, float u, std::uint32_t& tri, float& pmf) {
-  pmf = 0.0f;
-  tri = 0u;
-  if (nodes.empty()) return false;
-  const float total = nodes[0].boundsMin.w;
-  if (!(total > 0.0f)) return false;
-  const float target = u * total;
-  float running = 0.0f;
-  std::uint32_t chosen = gpu::kInvalidIndex;
-  for (std::uint32_t i = 0; i < nodes.size(); ++i) {
-    if ((nodes[i].link.y & gpu::kLightNodeLeaf) == 0u || !(nodes[i].boundsMin.w > 0.0f)) continue;
-    chosen = i;
-    running += nodes[i].boundsMin.w;
-    if (target < running) break;
-  }
-  if (chosen == gpu::kInvalidIndex) return false;
-  tri = nodes[chosen].link.x;
-  pmf = nodes[chosen].boundsMin.w / total;
-  return true;
-}
-
-float lightFlatPdf(const std::vector<gpu::LightNode>& nodes, std::uint32_t leaf) {
-  if (leaf >= nodes.size()) return 0.0f;
-  const float total = nodes[0].boundsMin.w;
-  return total > 0.0f ? std::max(nodes[leaf].boundsMin.w, 0.0f) / total : 0.0f;
-}
-
 bool sampleLightTree(const std::vector<gpu::LightNode>& nodes, const glm::vec3& p, const glm::vec3& n, float u,
                      std::uint32_t& tri, float& pmf) {
-  if (lightTreeIsFlat(nodes)) return sampleLightFlat(nodes, u, tri, pmf);
   pmf = 0.0f;
   if (nodes.empty()) return false;
   std::uint32_t i = 0;
@@ -318,7 +286,6 @@ bool sampleLightTree(const std::vector<gpu::LightNode>& nodes, const glm::vec3& 
 
 float lightTreePdf(const std::vector<gpu::LightNode>& nodes, const glm::vec3& p, const glm::vec3& n, std::uint32_t leaf) {
   if (leaf >= nodes.size()) return 0.0f;
-  if (lightTreeIsFlat(nodes)) return lightFlatPdf(nodes, leaf);
   std::uint32_t trail = nodes[leaf].link.z, depth = nodes[leaf].link.w;
   if (depth == 0u) return lightImportance(nodes[0], p, n) > 0.0f ? 1.0f : 0.0f;
   std::uint32_t i = 0;

@@ -35,16 +35,9 @@ LightTree buildLightTree(std::vector<LightTreeItem> items, std::size_t triangleC
 // on a surface with unit normal n (either side; n = 0: no surface): power x bounded emission cosine x
 // bounded receiver cosine / clamped squared distance. 0 where no triangle below can light p.
 float lightImportance(const gpu::LightNode& node, const glm::vec3& p, const glm::vec3& n);
-// True for a tree of at most CAUSTICA_LIGHT_FLAT_MAX leaves: sampleLightTree and lightTreePdf then
-// choose by power alone (sampleLightFlat, lightFlatPdf), without descent.
-bool lightTreeIsFlat(const std::vector<gpu::LightNode>& nodes);
-// Flat choice by power: the first leaf whose running power sum exceeds u * the root's power; pmf = its
-// power / the root's power. False if the tree has no power.
-bool sampleLightFlat(const std::vector<gpu::LightNode>& nodes, float u, std::uint32_t& tri, float& pmf);
-float lightFlatPdf(const std::vector<gpu::LightNode>& nodes, std::uint32_t leaf);
 // Descends from the root choosing each child in proportion to its importance, with u in [0, 1)
 // rescaled at every level. Returns false where no triangle can light p; else tri (TriGeom order) and
-// pmf, the probability of that choice. A flat tree (lightTreeIsFlat) is sampled by power instead.
+// pmf, the probability of that choice.
 bool sampleLightTree(const std::vector<gpu::LightNode>& nodes, const glm::vec3& p, const glm::vec3& n, float u,
                      std::uint32_t& tri, float& pmf);
 // The probability that sampleLightTree(p, n) chooses the triangle of leaf `leaf`, by repeating the

@@ -46,43 +46,9 @@ float lightImportance(LightNode node, vec3 p, vec3 n) {
   return max(importance, 0.0);
 }
 
-// The fast path for tiny trees (one or two emissive quads): at most CAUSTICA_LIGHT_FLAT_MAX leaves, i.e.
-// 2 * CAUSTICA_LIGHT_FLAT_MAX - 1 nodes. The triangle is chosen by power alone, scanning the leaves:
-// no importance evaluations (which cost ~10 % a sample there and choose nearly uniformly anyway).
-bool lightTreeIsFlat() { return uint(lightNodes.length()) + 1u <= 2u * uint(CAUSTICA_LIGHT_FLAT_MAX); }
-
-// Flat choice: the first leaf whose running power sum exceeds u * the root's power (the last leaf with
-// power takes what rounding leaves); pmf = its power / the root's power, exactly as lightFlatPdf.
-bool sampleLightFlat(float u, out uint tri, out float pmf) {
-  pmf = 0.0;
-  tri = 0u;
-  float total = lightNodes[0].boundsMin.w;
-  if (!(total > 0.0)) return false;
-  float target = u * total, running = 0.0;
-  uint chosen = 0xffffffffu, count = uint(lightNodes.length());
-  for (uint i = 0u; i < count; ++i) {
-    if ((lightNodes[i].link.y & kLightNodeLeaf) == 0u || !(lightNodes[i].boundsMin.w > 0.0)) continue;
-    chosen = i;
-    running += lightNodes[i].boundsMin.w;
-    if (target < running) break;
-  }
-  if (chosen == 0xffffffffu) return false;
-  tri = lightNodes[chosen].link.x;
-  pmf = lightNodes[chosen].boundsMin.w / total;
-  return true;
-}
-
-// The probability that sampleLightFlat chooses leaf node `leaf`.
-float lightFlatPdf(uint leaf) {
-  float total = lightNodes[0].boundsMin.w;
-  return total > 0.0 ? max(lightNodes[leaf].boundsMin.w, 0.0) / total : 0.0;
-}
-
 // Descends from the root choosing each child in proportion to its importance, u in [0, 1) rescaled at
 // every level. False where no triangle can light p; else tri (TriGeom order) and pmf, its probability.
-// A tiny tree (lightTreeIsFlat) is sampled flat by power instead (p and n unused).
 bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
-  if (lightTreeIsFlat()) return sampleLightFlat(u, tri, pmf);
   pmf = 0.0;
   tri = 0u;
   uint i = 0u;
@@ -115,7 +81,6 @@ bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
 // The probability that sampleLightTree(p, n) chooses the triangle of leaf node `leaf`: the same choices
 // repeated along the leaf's bit trail.
 float lightTreePdf(vec3 p, vec3 n, uint leaf) {
-  if (lightTreeIsFlat()) return lightFlatPdf(leaf);
   uint trail = lightNodes[leaf].link.z, depth = lightNodes[leaf].link.w;
   if (depth == 0u) return lightImportance(lightNodes[0], p, n) > 0.0 ? 1.0 : 0.0;
   uint i = 0u;

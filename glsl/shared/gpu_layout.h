@@ -146,9 +146,6 @@ struct LightNode {
 CAUSTICA_CONST uint kLightNodeLeaf = 1u;       // LightNode.link.y: a leaf (one triangle)
 CAUSTICA_CONST uint kLightNodeTwoSided = 2u;   // LightNode.link.y: some triangle below emits from both faces
 #define CAUSTICA_LIGHT_TREE_DEPTH 32           // bits of the trail: the builder keeps every leaf's depth <= this
-// Trees of at most this many emissive triangles are sampled flat, by power alone, without descent
-// (light_tree.glsl: lightTreeIsFlat); 0 turns the fast path off.
-#define CAUSTICA_LIGHT_FLAT_MAX 4
 
 // ---- UBO ---------------------------------------------------------------------------------------
 // Per-dispatch parameters (std140: vec4/uvec4 only).

@@ -1,7 +1,7 @@
 // light_tree_gpu_test.cpp — the GLSL light tree (glsl/lib/light_tree.glsl, run by
 // glsl/tests/light_tree_test.comp on llvmpipe) equals its C++ twins (app/accel/light_tree.h):
-// lightImportance, sampleLightTree and lightTreePdf, on the bundled many-lights scene's tree, on
-// random lights, and on tiny trees (the flat fast path), at random shading points.
+// lightImportance, sampleLightTree and lightTreePdf, on the bundled many-lights scene's tree and on
+// random lights, at random shading points.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -34,9 +34,7 @@ double relDiff(float a, float b) {
 }
 
 // Runs the GLSL functions on `queries` random points around the tree's bounds and compares.
-// flat: a tiny tree (the flat fast path never evaluates lightImportance; its points lie so close to
-// a tree of a few small triangles that importance's float cancellation reaches 8e-4: not checked).
-void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& nodes, std::uint32_t seed, bool flat = false) {
+void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& nodes, std::uint32_t seed) {
   REQUIRE(!nodes.empty());
   glm::vec3 lo(nodes[0].boundsMin), hi(nodes[0].boundsMax);
   glm::vec3 mid = 0.5f * (lo + hi), half = 0.6f * (hi - lo) + glm::vec3(0.1f);
@@ -104,8 +102,7 @@ void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& node
   CHECK(otherChoice <= n / 200);       // measured: 0 (many-lights), 0 (random)
   CHECK(worstPmf <= 1e-4);             // float rounding over ~10-20 levels; measured 2.4e-5
   CHECK(worstPdf <= 1e-4);             // measured 2.7e-5
-  if (!flat) CHECK(worstImportance <= 1e-4);  // measured 4.0e-5
-  if (flat) CHECK(worstPmf == 0.0);            // the same single division in both: measured exactly equal
+  CHECK(worstImportance <= 1e-4);      // measured 4.0e-5
 }
 
 }  // namespace
@@ -128,11 +125,4 @@ TEST_CASE("GLSL light tree equals its C++ twins: lightImportance, sampleLightTre
     items.push_back(t);
   }
   checkTwins("random lights", buildLightTree(items, 700).nodes, 2);
-  // Tiny trees take the flat fast path (choice by power, no descent) in both languages.
-  for (int n : {1, 2, CAUSTICA_LIGHT_FLAT_MAX}) {
-    std::vector<LightTreeItem> few(items.begin(), items.begin() + n);
-    const LightTree t = buildLightTree(few, 700);
-    REQUIRE(lightTreeIsFlat(t.nodes));
-    checkTwins("flat, " + std::to_string(n) + " lights", t.nodes, 4 + n, true);
-  }
 }
