@@ -129,6 +129,9 @@ std::vector<OptionSpec> sceneOptionSpecs() {
        "them, so their caustics appear (more noise)"},
       {"--backend", "", "NAME", "auto (EGL, then OSMesa; default), egl or osmesa"},
       {"--shader-dir", "", "DIR", "load shaders from DIR instead of the embedded copies"},
+      {"--all-features", "", "",
+       "compile every material feature into the path tracer instead of the scene's (measures specialisation; "
+       "same image)"},
       {"--quiet", "-q", "", "print nothing but errors"},
   };
   for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
@@ -325,6 +328,7 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
     m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
     throw Error(m.str());
   }
+  s.allFeatures = opts.has("--all-features");
   s.validate();
   return s;
 }

@@ -15,6 +15,8 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--size", "", "W[xH]", "image size in pixels (default 256; H follows the camera's aspect)"},
       {"--max-seconds", "", "S", "render time per estimator run in seconds (default 20)"},
       {"--integrators", "", "LIST", "estimators to compare, comma-separated (default naive,mis)"},
+      {"--adaptive", "", "LIST",
+       "estimators that also get an adaptive-sampling run, comma-separated (default mis; none for none)"},
       {"--dispersion", "", "LIST", "dispersion modes for scenes with dispersive glass (default rgb,spectral)"},
       {"--reference", "", "FILE", "linear .exr/.pfm reference (one scene, one mode) instead of rendering one"},
       {"--reference-spp", "", "N", "samples per pixel of rendered references (default: bench/scenes.json, else 1024)"},
@@ -29,6 +31,7 @@ int cmdBench(const std::vector<std::string>& args) {
       sceneOptionSpec("--camera"),
       sceneOptionSpec("--backend"),
       sceneOptionSpec("--shader-dir"),
+      sceneOptionSpec("--all-features"),
       {"--quiet", "-q", "", "print nothing but errors and the summary table"},
   };
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));

@@ -49,7 +49,7 @@ void RenderSettings::validate() const {
 bool RenderSettings::operator==(const RenderSettings& o) const {
   return width == o.width && height == o.height && seed == o.seed && maxDepth == o.maxDepth &&
          integrator == o.integrator && dispersion == o.dispersion && casterProbability == o.casterProbability &&
-         mode == o.mode;
+         mode == o.mode && allFeatures == o.allFeatures;
 }
 
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to) {
@@ -57,7 +57,8 @@ SettingsChange compareSettings(const RenderSettings& from, const RenderSettings&
   c.restart = from != to;
   c.resize = from.width != to.width || from.height != to.height;
   c.shader = from.integrator != to.integrator || from.dispersion != to.dispersion ||
-             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.mode != to.mode;
+             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.mode != to.mode ||
+             from.allFeatures != to.allFeatures;
   c.casters = from.casterProbability != to.casterProbability;
   return c;
 }

@@ -36,6 +36,10 @@ struct RenderSettings {
   // instead of cosine sampling; 0 turns it off; at most kMaxCasterProbability.
   float casterProbability = 0.5f;
   RenderMode mode = RenderMode::Path;
+  // Compile every material feature into the path tracer, whatever the scene uses (the shader is
+  // otherwise specialised to the scene's features): measures what specialisation saves
+  // (docs/benchmarks.md). The expected image does not change.
+  bool allFeatures = false;
 
   // Throws Error naming the first setting out of range.
   void validate() const;

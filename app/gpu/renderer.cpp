@@ -120,8 +120,19 @@ void Renderer::prepareMode() {
   }
 }
 
+namespace {
+// Every material feature define, for RenderSettings::allFeatures (the unspecialised shader).
+std::vector<std::string> allMaterialFeatureDefines() {
+  SceneFeatures f;
+  f.mirror = f.glass = f.volume = f.dispersion = f.textures = f.opacity = true;
+  f.environment = f.punctual = f.spotEmitters = f.ggx = true;
+  return f.defines();
+}
+}  // namespace
+
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
+  if (settings_.allFeatures && settings_.mode == RenderMode::Path) d = allMaterialFeatureDefines();
   if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {

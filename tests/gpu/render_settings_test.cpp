@@ -74,6 +74,13 @@ TEST_CASE("render settings: what each change asks of the renderer") {
   b.casterProbability = 0.0f;
   c = compareSettings(a, b);
   CHECK((c.restart && c.casters && c.shader));
+
+  // The all-features shader (--all-features): another variant, same image size.
+  b = a;
+  b.allFeatures = true;
+  c = compareSettings(a, b);
+  CHECK((c.restart && c.shader));
+  CHECK_FALSE((c.resize || c.casters));
 }
 
 TEST_CASE("render settings: names round-trip and unknown names are refused") {

@@ -2,6 +2,7 @@
 // mode, and one progressive run per estimator whose error is measured at log-spaced checkpoints.
 #include "cli/bench/bench_runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include "cli/bench/bench_metrics.h"
 #include "cli/bench/reference_cache.h"
 #include "cli/bench/report.h"
+#include "gpu/adaptive_sampler.h"
 #include "platform/context.h"
 #include "scene/assets.h"
 #include "util/error.h"
@@ -67,6 +69,9 @@ class BenchRunner {
     for (const auto& name : splitList(opts.get("--integrators", "naive,mis")))
       integrators_.push_back(parseIntegrator(name));
     if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis");
+    // --adaptive: the integrators that also get an adaptive run (default mis; "none" for none).
+    for (const auto& name : splitList(opts.get("--adaptive", "mis")))
+      if (name != "none") adaptiveIntegrators_.push_back(parseIntegrator(name));
     for (const auto& name : splitList(opts.get("--dispersion", "rgb,spectral")))
       dispersions_.push_back(parseDispersionMode(name));
     if (dispersions_.empty()) throw Error("option --dispersion needs at least one of rgb, spectral");
@@ -148,7 +153,10 @@ class BenchRunner {
         run.dispersion = mode;
         run.integrator = integrator;
         renderer.apply(run);
-        results.push_back(measure(renderer, name, ref, caustic));
+        results.push_back(measure(renderer, name, ref, caustic, false));
+        if (std::find(adaptiveIntegrators_.begin(), adaptiveIntegrators_.end(), integrator) !=
+            adaptiveIntegrators_.end())
+          results.push_back(measure(renderer, name, ref, caustic, true));
       }
     }
     std::string csv = writeSceneCsv(outDir_, name, results);
@@ -159,13 +167,16 @@ class BenchRunner {
   }
 
   // One progressive run: renders in batches sized to land just past each checkpoint; the clock
-  // counts rendering only (the read-back and error at each checkpoint are excluded).
+  // counts rendering only (the read-back and error at each checkpoint are excluded). An `adaptive`
+  // run samples the live tiles of AdaptiveSampler (docs/adaptive-sampling.md), checked at its fixed
+  // schedule; those checks (read-back, estimate, tile list) are part of adaptive sampling's cost and
+  // are on the clock. Its target is 0: it never stops early, so its error curve spans the same time.
   RunResult measure(Renderer& renderer, const std::string& name, const Reference& ref,
-                    const std::optional<PixelRect>& caustic) {
+                    const std::optional<PixelRect>& caustic, bool adaptive) {
     const RenderSettings& s = renderer.settings();
     RunResult out;
     out.scene = name;
-    out.integrator = estimatorName(s, !renderer.gpuScene().casters.empty());
+    out.integrator = estimatorName(s, !renderer.gpuScene().casters.empty()) + (adaptive ? " adaptive" : "");
     out.dispersion = dispersionModeName(s.dispersion);
     out.noise = ref.noise;
     out.noiseCaustic = ref.noiseCaustic;
@@ -177,10 +188,20 @@ class BenchRunner {
     const double pixels = double(s.width) * s.height;
     double elapsed = 0.0;  // seconds of rendering so far
     size_t next = 0;       // the next checkpoint in `schedule`
+    std::optional<AdaptiveSampler> sampler;
+    if (adaptive) sampler.emplace(0.0, true);
+    int nextCheck = sampler ? sampler->checkAtOrAfter(0) : 0;
     while (next < schedule.size()) {
       int n = nextBatchSpp(renderer.samplesPerPixel(), elapsed, schedule[next], kMaxDispatchSeconds);
+      // Under adaptive sampling a pass covers fewer pixels: the rate so far (spp per second) is
+      // then an underestimate of the next pass's, which only makes batches shorter.
+      if (sampler) n = std::max(1, std::min(n, nextCheck - renderer.samplesPerPixel()));
       auto t0 = Clock::now();
       renderer.renderPass(n);
+      if (sampler && renderer.samplesPerPixel() >= nextCheck) {
+        sampler->check(renderer);
+        nextCheck = sampler->checkAtOrAfter(renderer.samplesPerPixel() + 1);
+      }
       elapsed += secondsSince(t0);
       if (elapsed < schedule[next]) continue;
       while (next < schedule.size() && schedule[next] <= elapsed) ++next;
@@ -197,7 +218,8 @@ class BenchRunner {
       row.checkpoint = static_cast<int>(out.rows.size());
       row.seconds = elapsed;
       row.spp = renderer.samplesPerPixel();
-      row.samplesPerSecond = row.spp * pixels / elapsed;
+      // Adaptive runs sample some pixels only: count the paths traced (GPU counter) instead.
+      row.samplesPerSecond = adaptive ? double(st.primaryRays) / elapsed : row.spp * pixels / elapsed;
       row.raysPerSecond = double(st.rays()) / elapsed;
       row.primaryRays = st.primaryRays;
       row.secondaryRays = st.secondaryRays;
@@ -216,6 +238,7 @@ class BenchRunner {
       }
     }
     if (!quiet_) std::fprintf(stderr, "\n");
+    renderer.useAllTiles();
     if (out.rows.back().nonFinite > 0)
       note(quiet_, "warning: " + name + " " + out.integrator + ": " + std::to_string(out.rows.back().nonFinite) +
                        " non-finite samples were rejected");
@@ -227,7 +250,7 @@ class BenchRunner {
   BenchSetup setup_;  // GL renderer, backend and --max-seconds
   int referenceSpp_ = kDefaultReferenceSpp;
   std::string outDir_, cacheDir_;
-  std::vector<Integrator> integrators_;
+  std::vector<Integrator> integrators_, adaptiveIntegrators_;
   std::vector<DispersionMode> dispersions_;
   std::map<std::string, BenchSceneInfo> sceneInfo_;
   std::vector<RunResult> all_;  // every run of every scene so far, for the summary

@@ -126,6 +126,23 @@ std::string gnuplotScript(const BenchSetup& setup, const std::string& scene, int
   return f.str();
 }
 
+std::string adaptiveGainText(const RunResult& adaptive, const RunResult& uniform, bool caustic) {
+  auto [ta, ea] = errorCurve(adaptive, caustic);
+  auto [tu, eu] = errorCurve(uniform, caustic);
+  const ThresholdTime a = timeToThreshold(ta, ea, 0.01), u = timeToThreshold(tu, eu, 0.01);
+  const BenchRow &la = adaptive.rows.back(), &lu = uniform.rows.back();
+  const double effA = efficiency(caustic ? la.relMseCaustic : la.relMse, la.seconds);
+  const double effU = efficiency(caustic ? lu.relMseCaustic : lu.relMse, lu.seconds);
+  std::string text = "t(0.01) " + formatThresholdTime(a) + " against " + formatThresholdTime(u);
+  // A time already reached at the first checkpoint is only an upper bound: no ratio from it.
+  auto measured = [](const ThresholdTime& t) {
+    return t.kind == ThresholdTime::Kind::Interpolated || t.kind == ThresholdTime::Kind::Extrapolated;
+  };
+  if (measured(a) && measured(u) && a.seconds > 0.0)
+    text += formatDouble(" (%.2fx less time)", u.seconds / a.seconds);
+  return text + ", efficiency " + formatDouble("%.2fx", effA / effU);
+}
+
 std::string summaryMarkdown(const BenchSetup& setup, double totalSeconds, const std::vector<RunResult>& all) {
   std::ostringstream md;
   md << "GL renderer: " << setup.glRenderer << " (" << setup.backend << "); time limit "
@@ -157,7 +174,7 @@ std::string summaryMarkdown(const BenchSetup& setup, double totalSeconds, const 
   // mis against naive at the same scene and dispersion mode: the ratio of efficiencies.
   std::ostringstream cmp;
   for (const auto& m : all) {
-    if (m.integrator.rfind("mis", 0) != 0) continue;
+    if (m.integrator.rfind("mis", 0) != 0 || m.integrator.find(" adaptive") != std::string::npos) continue;
     for (const auto& n : all) {
       if (n.integrator != "naive" || n.scene != m.scene || n.dispersion != m.dispersion) continue;
       const BenchRow &a = m.rows.back(), &b = n.rows.back();
@@ -168,6 +185,22 @@ std::string summaryMarkdown(const BenchSetup& setup, double totalSeconds, const 
         cmp << ", "
             << formatDouble("%.2fx", efficiency(a.relMseCaustic, a.seconds) / efficiency(b.relMseCaustic, b.seconds))
             << " caustic region";
+      cmp << "\n";
+    }
+  }
+  // Adaptive against uniform sampling of the same estimator: time to relMSE 0.01 measured against the
+  // reference (whole image and caustic region), and the efficiency ratio at the last checkpoint.
+  const std::string suffix = " adaptive";
+  for (const auto& a : all) {
+    if (a.integrator.size() <= suffix.size() ||
+        a.integrator.compare(a.integrator.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    const std::string base = a.integrator.substr(0, a.integrator.size() - suffix.size());
+    for (const auto& u : all) {
+      if (u.integrator != base || u.scene != a.scene || u.dispersion != a.dispersion) continue;
+      cmp << "- " << a.scene << (a.dispersion == "rgb" ? "" : " (" + a.dispersion + ")") << ": " << a.integrator
+          << "/" << base << " " << adaptiveGainText(a, u, false);
+      if (a.hasCaustic) cmp << "; caustic region " << adaptiveGainText(a, u, true);
       cmp << "\n";
     }
   }

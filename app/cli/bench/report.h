@@ -42,6 +42,9 @@ std::string gnuplotQuote(const std::string& text);
 // region, dotted lines at the references' own noise. `width` x `height`: the image size in pixels.
 std::string gnuplotScript(const BenchSetup& setup, const std::string& scene, int width, int height,
                           const std::vector<RunResult>& results);
+// "t(0.01) 1.2 s against 3.4 s (2.83x less time), efficiency 2.9x": an adaptive run against the uniform
+// run of the same estimator (caustic: in the caustic region), for the summary.
+std::string adaptiveGainText(const RunResult& adaptive, const RunResult& uniform, bool caustic);
 // summary.md: a header line, a table row per run, mis/naive efficiency ratios per scene and mode,
 // and a note on the columns. `totalSeconds`: wall time of the whole bench, seconds.
 std::string summaryMarkdown(const BenchSetup& setup, double totalSeconds, const std::vector<RunResult>& all);

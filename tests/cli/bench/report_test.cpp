@@ -159,6 +159,24 @@ TEST_CASE("summary.md: a row per run, threshold times, efficiency ratios of mis 
   CHECK(alone.find("|\n\nt(x): ") != std::string::npos);
 }
 
+TEST_CASE("summary.md: an adaptive run is compared with the uniform run of its estimator") {
+  BenchSetup setup{"llvmpipe", "osmesa", 2.0};
+  RunResult naive = makeRun("box", "naive", "rgb", {1.0, 2.0}, {0.1, 0.05}, {});
+  RunResult mis = makeRun("box", "mis", "rgb", {1.0, 2.0}, {0.02, 0.01}, {0.2, 0.1});
+  RunResult adaptive = makeRun("box", "mis adaptive", "rgb", {1.0, 2.0}, {0.01, 0.005}, {0.05, 0.025});
+  // Whole image: 0.01 at the first checkpoint (an upper bound: no time ratio) against 2 s; efficiency
+  // 1/(0.005 x 2) against 1/(0.01 x 2). Caustic region: 0.025 at 2 s reaches 0.01 at ~5 s (1/time),
+  // uniform 0.1 at ~20 s.
+  CHECK(adaptiveGainText(adaptive, mis, false) == "t(0.01) <=1 s against 2 s, efficiency 2.00x");
+  CHECK(adaptiveGainText(adaptive, mis, true) == "t(0.01) ~5 s against ~20 s (4.00x less time), efficiency 4.00x");
+  const std::string md = summaryMarkdown(setup, 3.0, {naive, mis, adaptive});
+  CHECK(md.find("- box: mis adaptive/mis t(0.01) <=1 s against 2 s, efficiency 2.00x; caustic "
+                "region t(0.01) ~5 s against ~20 s (4.00x less time), efficiency 4.00x\n") != std::string::npos);
+  // mis/naive compares the uniform runs only.
+  CHECK(md.find("mis adaptive/naive") == std::string::npos);
+  CHECK(md.find("- box: mis/naive efficiency") != std::string::npos);
+}
+
 TEST_CASE("the caustic region is outlined one pixel outside it") {
   Image img{6, 6, std::vector<float>(6 * 6 * 3, 1.0f)};
   Image out = outlined(img, PixelRect{2, 2, 4, 4}, 4.0f);
