@@ -24,6 +24,9 @@
 #endif
 #include "lib/vertex.glsl"
 #include "lib/accumulate.glsl"
+#ifdef CAUSTICA_TRANSPARENT
+#include "lib/coverage.glsl"
+#endif
 #include "lib/adaptive.glsl"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
@@ -96,6 +99,9 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     if (depth + passThroughs > 0u) ++gSecondaryRays;
     Hit hit;
     if (!traceClosest(org, dir, 3.0e38, hit)) {
+#ifdef CAUSTICA_TRANSPARENT
+      if (depth == 0u) gCameraRayMissed = true;  // alpha 0 for this sample (coverage.glsl)
+#endif
 #ifdef CAUSTICA_ENV
       radiance += beta * filt * escapedRadiance(dir, depth == 0u, prevDelta, prevPdf);  // environment_light.glsl
 #endif
@@ -324,6 +330,9 @@ void main() {
     bool finite = !(any(isnan(l)) || any(isinf(l)));
     if (!finite) bad = 1u;  // counted and reported; not part of the pixel's mean (neither as black)
     accumulate(ivec2(pixel), finite ? l : vec3(0.0), finite ? 1.0 : 0.0);
+#ifdef CAUSTICA_TRANSPARENT
+    accumulateCoverage(ivec2(pixel), finite && !gCameraRayMissed ? 1.0 : 0.0);
+#endif
   }
   atomicAdd(groupCounts[0], primary);
   atomicAdd(groupCounts[1], gSecondaryRays);

@@ -16,6 +16,9 @@ bool whittedOccluder(uint tri);  // below: emitters do not occlude in this mode
 #include "lib/materials.glsl"
 #include "lib/point_lights.glsl"
 #include "lib/accumulate.glsl"
+#ifdef CAUSTICA_TRANSPARENT
+#include "lib/coverage.glsl"
+#endif
 #include "lib/adaptive.glsl"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
@@ -93,7 +96,12 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
     PendingRay r = gStack[--gSp];
     if (rays > 0u) ++gSecondaryRays;
     Hit hit;
-    if (!traceClosest(r.org, r.dir, 3.0e38, hit)) continue;
+    if (!traceClosest(r.org, r.dir, 3.0e38, hit)) {
+#ifdef CAUSTICA_TRANSPARENT
+      if (rays == 0u) gCameraRayMissed = true;  // the eye ray: alpha 0 for this sample (coverage.glsl)
+#endif
+      continue;
+    }
     vec3 w = r.weight;
 #ifdef CAUSTICA_VOLUME
     w *= exp(-r.sigma * hit.t);
@@ -193,6 +201,9 @@ void main() {
     bool finite = !(any(isnan(l)) || any(isinf(l)));
     if (!finite) bad = 1u;
     accumulate(ivec2(pixel), finite ? l : vec3(0.0), finite ? 1.0 : 0.0);
+#ifdef CAUSTICA_TRANSPARENT
+    accumulateCoverage(ivec2(pixel), finite && !gCameraRayMissed ? 1.0 : 0.0);
+#endif
   }
   atomicAdd(groupCounts[0], primary);
   atomicAdd(groupCounts[1], gSecondaryRays);

@@ -1,5 +1,6 @@
 // checkpoint.cpp — checkpoint file format: a text header after the magic line, then the three images'
-// raw floats (sums, Kahan compensation, odd-sample half) (native little-endian), protected by an FNV-1a 64 checksum.
+// raw floats (sums, Kahan compensation, odd-sample half) and, with "coverage 1", the coverage image's
+// (native little-endian), protected by an FNV-1a 64 checksum.
 #include "cli/checkpoint.h"
 
 #include <cerrno>
@@ -39,7 +40,8 @@ namespace {
 std::uint64_t dataHash(const AccumulationState& st) {
   std::uint64_t h = fnv1a64(st.accum.data(), st.accum.size() * sizeof(float));
   h = fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
-  return fnv1a64(st.half.data(), st.half.size() * sizeof(float), h);
+  h = fnv1a64(st.half.data(), st.half.size() * sizeof(float), h);
+  return st.coverage.empty() ? h : fnv1a64(st.coverage.data(), st.coverage.size() * sizeof(float), h);
 }
 
 std::map<std::string, std::string> parseLines(const std::string& text) {
@@ -58,13 +60,15 @@ std::map<std::string, std::string> parseLines(const std::string& text) {
 void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
   const AccumulationState& st = ck.state;
   const size_t n = static_cast<size_t>(st.width) * st.height * 4;
-  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n) throw Error("internal: checkpoint images do not match its size");
+  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n || (!st.coverage.empty() && st.coverage.size() != n / 4))
+    throw Error("internal: checkpoint images do not match its size");
   std::ostringstream h;
   h << kCheckpointMagic << ' ' << kCheckpointVersion << '\n'
     << "width " << st.width << '\n'
     << "height " << st.height << '\n'
     << "spp " << st.spp << '\n'
     << "sample-base " << st.sampleBase << '\n'
+    << "coverage " << (st.coverage.empty() ? 0 : 1) << '\n'
     << "seed " << ck.seed << '\n'
     << "scene " << hex64(ck.sceneHash) << '\n'
     << "data " << hex64(dataHash(st)) << '\n'
@@ -78,6 +82,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     out.write(reinterpret_cast<const char*>(st.accum.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.comp.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.half.data()), static_cast<std::streamsize>(n * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(st.coverage.data()), static_cast<std::streamsize>(st.coverage.size() * sizeof(float)));
     out.close();
     if (!out) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
   });
@@ -103,8 +108,11 @@ Checkpoint readCheckpoint(const std::string& path) {
     if (*e != '\0') throw bad(std::string("bad ") + key + " '" + it->second + "'");
     return v;
   };
-  if (num(kCheckpointMagic) != static_cast<unsigned long long>(kCheckpointVersion))
-    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads version " + std::to_string(kCheckpointVersion) + ")");
+  const unsigned long long version = num(kCheckpointMagic);
+  if (version < kCheckpointOldestVersion || version > kCheckpointVersion)
+    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads versions " +
+              std::to_string(kCheckpointOldestVersion) + " to " + std::to_string(kCheckpointVersion) + ")");
+  const bool coverage = version >= 3 && num("coverage") != 0;  // version 2: opaque renders only
   Checkpoint ck;
   AccumulationState& st = ck.state;
   unsigned long long w = num("width"), hgt = num("height"), settingsBytes = num("settings");
@@ -122,15 +130,20 @@ Checkpoint readCheckpoint(const std::string& path) {
   ck.settingsText = bytes.substr(settingsLineEnd + 1, settingsBytes);
   const size_t dataAt = end + 5;
   const size_t n = static_cast<size_t>(w) * hgt * 4;
-  if (bytes.size() != dataAt + 3 * n * sizeof(float))
+  const size_t dataBytes = (3 * n + (coverage ? n / 4 : 0)) * sizeof(float);
+  if (bytes.size() != dataAt + dataBytes)
     throw bad("holds " + std::to_string(bytes.size() - dataAt) + " bytes of image data, expected " +
-              std::to_string(3 * n * sizeof(float)) + " (truncated?)");
+              std::to_string(dataBytes) + " (truncated?)");
   st.accum.resize(n);
   st.comp.resize(n);
   st.half.resize(n);
   std::memcpy(st.accum.data(), bytes.data() + dataAt, n * sizeof(float));
   std::memcpy(st.comp.data(), bytes.data() + dataAt + n * sizeof(float), n * sizeof(float));
   std::memcpy(st.half.data(), bytes.data() + dataAt + 2 * n * sizeof(float), n * sizeof(float));
+  if (coverage) {
+    st.coverage.resize(n / 4);
+    std::memcpy(st.coverage.data(), bytes.data() + dataAt + 3 * n * sizeof(float), n / 4 * sizeof(float));
+  }
   if (dataHash(st) != expected) throw bad("the image data fails its checksum (corrupted)");
   return ck;
 }

@@ -12,10 +12,13 @@ namespace caustica::cli {
 
 constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
 // 2: adds the odd-sample half image (error estimate, adaptive sampling); version 1 files are refused.
-constexpr int kCheckpointVersion = 2;
+// 3: adds a "coverage 0|1" header line and, with 1, the r32f coverage image after the three others
+// (--background transparent); version 2 files still load (no coverage: opaque renders).
+constexpr int kCheckpointVersion = 3;
+constexpr int kCheckpointOldestVersion = 2;
 
 struct Checkpoint {
-  AccumulationState state;        // the three rgba32f images, spp and the next global sample index
+  AccumulationState state;        // the three rgba32f images (+ coverage), spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
   std::string settingsText;       // checkpointSettingsText(...)

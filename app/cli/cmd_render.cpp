@@ -78,6 +78,8 @@ int cmdRender(const std::vector<std::string>& args) {
   const auto commandStart = std::chrono::steady_clock::now();
   LoadedScene ls = loadSceneForCli(opts, !quiet);
   const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
+  if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
+    throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);

@@ -14,7 +14,8 @@ std::vector<OptionSpec> environmentOptionSpecs() {
       {"--env-strength", "", "S", "multiplies the environment's radiance (default 1)"},
       {"--env-rotation", "", "DEG", "turns the environment map about +Y, right-handed (default 0)"},
       {"--background", "", "WHAT",
-       "what camera rays that leave the scene see: env (default) or a colour (0.2 or R,G,B)"},
+       "what camera rays that leave the scene see: env (default), a colour (0.2 or R,G,B) or transparent "
+       "(alpha 0 in .png/.exr; the environment still lights the scene)"},
   };
 }
 
@@ -34,6 +35,8 @@ void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
   const float rotation = static_cast<float>(opts.getDouble("--env-rotation", 0.0));
   if (!(strength >= 0.0f)) throw Error("option --env-strength needs a non-negative number");
   scene.background = parseBackground(opts.get("--background", "env"));
+  if (scene.background.kind == Background::Kind::Transparent && opts.get("--mode", "path") == "raster")
+    note(!verbose, "warning: --mode raster draws an opaque image: --background transparent needs --mode path or whitted");
   scene.environment = Environment{};
   const bool emitters = sceneHasLights(scene);  // emissive triangles (the environment is not set yet)
   if (opts.has("--env")) {

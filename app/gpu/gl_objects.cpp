@@ -128,6 +128,10 @@ void GlTexture::clear() {
   if (format_ == GL_RGBA32F) {
     std::vector<float> zeros(static_cast<std::size_t>(width_) * height_ * 4, 0.0f);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, zeros.data());
+  } else if (format_ == GL_R32F) {
+    std::vector<float> zeros(static_cast<std::size_t>(width_) * height_, 0.0f);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RED, GL_FLOAT, zeros.data());
   } else if (format_ == GL_R32UI) {
     std::vector<GLuint> zeros(static_cast<std::size_t>(width_) * height_, 0u);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
@@ -161,6 +165,29 @@ void GlTexture::uploadRgba32f(const std::vector<float>& rgba) {
   glBindTexture(GL_TEXTURE_2D, id());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, rgba.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("image upload");
+}
+
+std::vector<float> GlTexture::readR32f() const {
+  if (format_ != GL_R32F) throw Error("internal: readR32f needs an r32f texture");
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  std::vector<float> out(static_cast<std::size_t>(width_) * height_);
+  glBindTexture(GL_TEXTURE_2D, id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_FLOAT, out.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  checkGlError("image readback");
+  return out;
+}
+
+void GlTexture::uploadR32f(const std::vector<float>& values) {
+  if (format_ != GL_R32F || values.size() != static_cast<std::size_t>(width_) * height_)
+    throw Error("internal: uploadR32f needs an r32f texture and width*height floats");
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glBindTexture(GL_TEXTURE_2D, id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RED, GL_FLOAT, values.data());
   glBindTexture(GL_TEXTURE_2D, 0);
   checkGlError("image upload");
 }

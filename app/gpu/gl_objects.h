@@ -72,6 +72,9 @@ class GlTexture {
   std::vector<float> readRgba32f() const;  // width*height*4 floats, row 0 first
   // Replaces every texel of an rgba32f texture with `rgba` (width*height*4 floats, row 0 first).
   void uploadRgba32f(const std::vector<float>& rgba);
+  // r32f texture (the coverage image): width*height floats, row 0 first.
+  std::vector<float> readR32f() const;
+  void uploadR32f(const std::vector<float>& values);
   // r32ui texture: writes `values` row by row from texel (0, 0), the last row padded with zeros.
   void uploadR32uiRows(const std::vector<std::uint32_t>& values);
   // Raster mode: an sRGB RGBA8 colour texture with mipmaps (rgba8: width*height*4 bytes, row 0 =

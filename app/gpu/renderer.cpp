@@ -114,6 +114,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   environment_.upload(g, limits_, scene.path);
   glFinish();
   load_.upload = since(t0);
+  transparent_ = g.environmentParams.size.z == gpu::kBackgroundTransparent;
   allocateImages();
   t0 = std::chrono::steady_clock::now();
   prepareMode();  // compile now, so shader errors surface before rendering starts
@@ -148,6 +149,7 @@ std::vector<std::string> Renderer::shaderDefines() const {
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
+  if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
@@ -217,6 +219,7 @@ void Renderer::allocateImages() {
   accum_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   comp_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   half_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
+  coverage_ = transparent_ ? GlTexture::create2D(settings_.width, settings_.height, GL_R32F) : GlTexture();
   const int tiles = ((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X) *
                     ((settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
   tileList_ = GlTexture::create2D(CAUSTICA_TILE_LIST_WIDTH, (tiles + CAUSTICA_TILE_LIST_WIDTH - 1) / CAUSTICA_TILE_LIST_WIDTH,
@@ -229,6 +232,7 @@ void Renderer::reset() {
   accum_.clear();
   comp_.clear();
   half_.clear();
+  if (transparent_) coverage_.clear();
   useAllTiles();
   spp_ = 0;
   sampleBase_ = 0;
@@ -317,6 +321,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);
   tileList_.bindImage(CAUSTICA_IMAGE_TILES, GL_READ_ONLY);
+  if (hasAlpha()) coverage_.bindImage(CAUSTICA_IMAGE_COVERAGE, GL_READ_WRITE);
   // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested
   // loops together (65535 from the outermost loop's start) and silently stops beyond; a per-sample
   // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
@@ -371,6 +376,7 @@ AccumulationState Renderer::saveAccumulation() const {
   st.accum = accum_.readRgba32f();
   st.comp = comp_.readRgba32f();
   st.half = half_.readRgba32f();
+  if (transparent_) st.coverage = coverage_.readR32f();
   return st;
 }
 
@@ -381,10 +387,13 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
                 " but the renderer is " + std::to_string(settings_.width) + "x" + std::to_string(settings_.height));
   if (state.accum.size() != n || state.comp.size() != n || state.half.size() != n || state.spp < 0)
     throw Error("the saved accumulation is incomplete");
+  if (transparent_ && state.coverage.size() != n / 4)
+    throw Error("the saved accumulation has no coverage (alpha): it was not rendered with --background transparent");
   reset();
   accum_.uploadRgba32f(state.accum);
   comp_.uploadRgba32f(state.comp);
   half_.uploadRgba32f(state.half);
+  if (transparent_) coverage_.uploadR32f(state.coverage);
   spp_ = state.spp;
   sampleBase_ = state.sampleBase;
 }
@@ -395,6 +404,14 @@ Image Renderer::image() const {
   for (size_t i = 0; i < static_cast<size_t>(settings_.width) * settings_.height; ++i) {
     float n = rgba[i * 4 + 3];
     for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = n > 0.0f ? rgba[i * 4 + c] / n : 0.0f;
+  }
+  if (hasAlpha()) {  // rgb stays the mean over all samples (misses add 0): premultiplied by alpha
+    std::vector<float> hits = coverage_.readR32f();
+    img.alpha.resize(hits.size());
+    for (size_t i = 0; i < hits.size(); ++i) {
+      float n = rgba[i * 4 + 3];
+      img.alpha[i] = n > 0.0f ? std::min(hits[i] / n, 1.0f) : 0.0f;
+    }
   }
   return img;
 }
@@ -410,7 +427,9 @@ const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {
   tonemapProgram_.use();
   glUniform1f(0, std::exp2(tone.exposureStops));
   glUniform1i(1, static_cast<int>(tone.curve));
+  glUniform1i(2, hasAlpha() ? 1 : 0);  // composite over a checkerboard (tonemap.comp)
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_ONLY);
+  if (hasAlpha()) coverage_.bindImage(CAUSTICA_IMAGE_COVERAGE, GL_READ_ONLY);
   display_.bindImage(CAUSTICA_IMAGE_DISPLAY, GL_WRITE_ONLY);
   glDispatchCompute((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,
                     (settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y, 1);

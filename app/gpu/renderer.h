@@ -47,6 +47,8 @@ struct AccumulationState {
   std::vector<float> accum;     // rgba32f running sums (rgb radiance, a = sample count), width*height*4
   std::vector<float> comp;      // rgba32f Kahan compensation terms of those sums, width*height*4
   std::vector<float> half;      // rgba32f sums of each pixel's odd-numbered samples (rgb) and their count (a)
+  std::vector<float> coverage;  // r32f samples whose camera ray hit the scene, width*height; empty unless
+                                // the background is transparent
 };
 
 // Seconds the Renderer spent getting a scene ready (docs/benchmarks.md, "Big scenes").
@@ -91,7 +93,10 @@ class Renderer {
   // Continues from `state` (saved from a renderer with the same scene and settings): the next pass
   // renders exactly the samples an uninterrupted render would. Throws Error unless its size matches.
   void restoreAccumulation(const AccumulationState& state);
-  Image image() const;                           // mean radiance per pixel (linear)
+  Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
+  // --background transparent in a mode that tracks coverage (path, Whitted; not raster): image() has
+  // alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
+  bool hasAlpha() const { return transparent_ && settings_.mode != RenderMode::Raster; }
   // Tone-maps the accumulation into the rgba8 display texture (viewer).
   const GlTexture& updateDisplay(const ToneMapSettings& tone);
   const RenderStats& stats() const { return stats_; }
@@ -138,6 +143,8 @@ class Renderer {
   EnvironmentTextures environment_;  // environment map, CDFs and UBO
   GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
   GlTexture accum_, comp_, half_, tileList_, display_;
+  bool transparent_ = false;  // the scene's background is transparent: coverage_ exists
+  GlTexture coverage_;        // r32f camera-ray hits per pixel (CAUSTICA_IMAGE_COVERAGE), if transparent_
   std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_
   bool tileListActive_ = false;
   std::map<std::string, GlProgram> programs_;

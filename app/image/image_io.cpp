@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -30,8 +31,8 @@ void checkImageExtension(const std::string& path) {
     throw Error(path + ": unsupported image type '" + ext + "' (use .png, .exr or .pfm)");
 }
 
-void writePng(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
-  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3))
+void writePng(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb, int channels) {
+  if (!stbi_write_png(path.c_str(), width, height, channels, rgb.data(), width * channels))
     throw Error(path + ": cannot write PNG");
 }
 
@@ -40,7 +41,17 @@ namespace {
 void writeExr(const std::string& path, const Image& img) {
   // tinyexr's SaveEXR takes interleaved RGB(A) floats and writes them as 32-bit float channels.
   const char* err = nullptr;
-  int rc = SaveEXR(img.rgb.data(), img.width, img.height, 3, 0 /* float, not half */, path.c_str(), &err);
+  std::vector<float> rgba;
+  if (!img.alpha.empty()) {  // OpenEXR's convention: colour premultiplied by alpha, which rgb already is
+    const size_t n = static_cast<size_t>(img.width) * img.height;
+    rgba.resize(n * 4);
+    for (size_t i = 0; i < n; ++i) {
+      for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = img.rgb[i * 3 + c];
+      rgba[i * 4 + 3] = img.alpha[i];
+    }
+  }
+  int rc = rgba.empty() ? SaveEXR(img.rgb.data(), img.width, img.height, 3, 0 /* float, not half */, path.c_str(), &err)
+                        : SaveEXR(rgba.data(), img.width, img.height, 4, 0, path.c_str(), &err);
   if (rc != TINYEXR_SUCCESS) {
     std::string msg = err ? err : "error " + std::to_string(rc);
     if (err) FreeEXRErrorMessage(err);
@@ -94,10 +105,28 @@ Image readPfm(const std::string& path) {
 
 }  // namespace
 
+std::vector<float> unpremultiplied(const Image& image) {
+  std::vector<float> rgb = image.rgb;
+  for (size_t i = 0; i < image.alpha.size(); ++i)
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = image.alpha[i] > 0.0f ? rgb[i * 3 + c] / image.alpha[i] : 0.0f;
+  return rgb;
+}
+
 void writeImage(const std::string& path, const Image& image, const ToneMapSettings& tone) {
   checkImageExtension(path);
   std::string ext = fileExtension(path);
-  if (ext == ".png") writePng(path, image.width, image.height, tonemapImage(image.rgb, tone));
+  if (!image.alpha.empty() && image.alpha.size() != static_cast<size_t>(image.width) * image.height)
+    throw Error("internal: " + path + ": alpha of the wrong size");
+  if (ext == ".png" && !image.alpha.empty()) {
+    std::vector<std::uint8_t> rgb = tonemapImage(unpremultiplied(image), tone), rgba(image.alpha.size() * 4);
+    for (size_t i = 0; i < image.alpha.size(); ++i) {
+      for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = rgb[i * 3 + c];
+      rgba[i * 4 + 3] = static_cast<std::uint8_t>(std::lround(std::clamp(image.alpha[i], 0.0f, 1.0f) * 255.0f));
+    }
+    writePng(path, image.width, image.height, rgba, 4);
+  } else if (ext == ".pfm" && !image.alpha.empty()) {
+    throw Error(path + ": PFM has no alpha channel: write .exr or .png with --background transparent");
+  } else if (ext == ".png") writePng(path, image.width, image.height, tonemapImage(image.rgb, tone));
   else if (ext == ".exr") writeExr(path, image);
   else writePfm(path, image);
 }

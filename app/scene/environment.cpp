@@ -159,9 +159,10 @@ Environment parseEnvironment(const std::string& text, float strength, float rota
 Background parseBackground(const std::string& text) {
   Background b;
   if (text == "env") return b;
-  if (text == "transparent")  // needs a coverage channel beside the accumulation image: not built yet
-    throw Error("option --background transparent is not supported yet (images have no alpha channel); "
-                "use env or a colour");
+  if (text == "transparent") {
+    b.kind = Background::Kind::Transparent;
+    return b;
+  }
   if (!parseColor(text, b.color))
     throw Error("option --background needs env, transparent or a colour (0.2 or R,G,B, non-negative), got '" + text +
                 "'");

@@ -47,8 +47,8 @@ Environment loadEnvironmentMap(const std::string& path, float strength = 1.0f, f
 std::string resolveEnvironmentPath(const std::string& nameOrPath);
 // Builds an environment from the text of --env: "none", a number "0.8", "R,G,B", or a file name.
 Environment parseEnvironment(const std::string& text, float strength, float rotationDegrees);
-// Parses --background: "env" or a colour ("0.2" or "R,G,B"); "transparent" (Kind::Transparent, for
-// which the shader already returns radiance 0) is refused until images carry an alpha channel.
+// Parses --background: "env", "transparent" (radiance 0 and alpha 0 where camera rays leave the scene)
+// or a colour ("0.2" or "R,G,B").
 Background parseBackground(const std::string& text);
 // Parses "x" or "r,g,b" of non-negative finite numbers; false if `text` is not one.
 bool parseColor(const std::string& text, glm::vec3& out);

@@ -70,8 +70,37 @@ TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
   CHECK(b.state.accum == a.state.accum);
   CHECK(b.state.comp == a.state.comp);
   CHECK(b.state.half == a.state.half);
-  CHECK(slurp(path).rfind("CAUSTICA-CKPT 2\n", 0) == 0);
+  CHECK(b.state.coverage.empty());  // an opaque render has no coverage image
+  CHECK(slurp(path).rfind("CAUSTICA-CKPT 3\n", 0) == 0);
   CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.settingsText).empty());
+}
+
+TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; version 2 files still load") {
+  std::string path = tempPath("coverage.ckpt");
+  Checkpoint a = sample(3, 2, 1.5f);
+  for (int i = 0; i < 6; ++i) a.state.coverage.push_back(float(i % 3) * 4.0f);
+  writeCheckpoint(path, a);
+  Checkpoint b = readCheckpoint(path);
+  CHECK(b.state.coverage == a.state.coverage);
+  CHECK(b.state.accum == a.state.accum);
+  std::string bytes = slurp(path);
+  CHECK(bytes.find("\ncoverage 1\n") != std::string::npos);
+  // Its coverage is checksummed too, and a missing coverage block reads as truncated.
+  std::string flipped = bytes;
+  flipped[flipped.size() - 2] ^= 0x10;
+  spit(path, flipped);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
+  spit(path, bytes.substr(0, bytes.size() - 6 * sizeof(float)));
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("truncated"), Error);
+  // A version-2 file (written before coverage existed: no coverage line, three images) loads as opaque.
+  writeCheckpoint(path, sample(3, 2, 1.5f));
+  std::string v2 = slurp(path);
+  v2.replace(0, std::string("CAUSTICA-CKPT 3").size(), "CAUSTICA-CKPT 2");
+  v2.erase(v2.find("coverage 0\n"), std::string("coverage 0\n").size());
+  spit(path, v2);
+  Checkpoint old = readCheckpoint(path);
+  CHECK(old.state.coverage.empty());
+  CHECK(old.state.half == a.state.half);
 }
 
 TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with the file's name") {
@@ -88,9 +117,9 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
   // A version-1 file (no half image: no error estimate to resume adaptive sampling from) is refused.
   std::string v1 = good;
-  v1.replace(0, std::string("CAUSTICA-CKPT 2").size(), "CAUSTICA-CKPT 1");
+  v1.replace(0, std::string("CAUSTICA-CKPT 3").size(), "CAUSTICA-CKPT 1");
   spit(path, v1);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads version 2)"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 2 to 3)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);

@@ -130,6 +130,22 @@ TEST_CASE("the punctual-light variants compile on top of every integrator and ma
     }
 }
 
+TEST_CASE("the transparent-background variant (coverage image) compiles in both tracers on top of every feature") {
+  ShaderLibrary lib;
+  const auto& names = shaderFeatureNames();
+  std::vector<std::vector<std::string>> bases = {{}, names};
+  for (const auto& n : names) bases.push_back({n});
+  for (const char* entry : {"pathtrace.comp", "whitted.comp"})
+    for (auto defines : bases) {
+      defines.push_back("CAUSTICA_TRANSPARENT");
+      std::string label = entry + std::string(": ");
+      for (const auto& d : defines) label += d + " ";
+      INFO("defines: ", label);
+      const std::string log = validate(lib.expand(entry, defines));
+      REQUIRE_MESSAGE(log.empty(), log);
+    }
+}
+
 TEST_CASE("the other entry shaders compile") {
   ShaderLibrary lib;
   for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/twins_test.comp", "tests/environment_test.comp"}) {

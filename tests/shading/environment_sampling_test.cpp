@@ -182,7 +182,7 @@ TEST_CASE("environment files: .hdr and .exr read with strength; bad input named;
   CHECK(u.kind == Environment::Kind::Uniform);
   CHECK(u.uniform == glm::vec3(1.0f, 2.0f, 4.0f));
   CHECK(parseBackground("env").kind == Background::Kind::Environment);
-  CHECK_THROWS_WITH_AS(parseBackground("transparent"), doctest::Contains("not supported yet"), Error);
+  CHECK(parseBackground("transparent").kind == Background::Kind::Transparent);
   CHECK(parseBackground("0.2").color == glm::vec3(0.2f));
   CHECK_THROWS_WITH_AS(parseBackground("blue"), doctest::Contains("option --background needs"), Error);
   fs::remove(p);
