@@ -147,49 +147,43 @@ void GlTexture::bindImage(GLuint unit, GLenum access) const {
   glBindImageTexture(unit, id(), 0, GL_FALSE, 0, access, format_);
 }
 
-std::vector<float> GlTexture::readRgba32f() const {
+std::vector<float> GlTexture::readFloats(GLenum format, int channels) const {
   glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
-  std::vector<float> out(static_cast<std::size_t>(width_) * height_ * 4);
+  std::vector<float> out(static_cast<std::size_t>(width_) * height_ * channels);
   glBindTexture(GL_TEXTURE_2D, id());
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, out.data());
+  glGetTexImage(GL_TEXTURE_2D, 0, format, GL_FLOAT, out.data());
   glBindTexture(GL_TEXTURE_2D, 0);
   checkGlError("image readback");
   return out;
 }
 
-void GlTexture::uploadRgba32f(const std::vector<float>& rgba) {
-  if (format_ != GL_RGBA32F || rgba.size() != static_cast<std::size_t>(width_) * height_ * 4)
-    throw Error("internal: uploadRgba32f needs an rgba32f texture and width*height*4 floats");
+void GlTexture::uploadFloats(GLenum format, const std::vector<float>& values) {
   glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   glBindTexture(GL_TEXTURE_2D, id());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, rgba.data());
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, format, GL_FLOAT, values.data());
   glBindTexture(GL_TEXTURE_2D, 0);
   checkGlError("image upload");
 }
 
+std::vector<float> GlTexture::readRgba32f() const { return readFloats(GL_RGBA, 4); }
+
+void GlTexture::uploadRgba32f(const std::vector<float>& rgba) {
+  if (format_ != GL_RGBA32F || rgba.size() != static_cast<std::size_t>(width_) * height_ * 4)
+    throw Error("internal: uploadRgba32f needs an rgba32f texture and width*height*4 floats");
+  uploadFloats(GL_RGBA, rgba);
+}
+
 std::vector<float> GlTexture::readR32f() const {
   if (format_ != GL_R32F) throw Error("internal: readR32f needs an r32f texture");
-  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
-  std::vector<float> out(static_cast<std::size_t>(width_) * height_);
-  glBindTexture(GL_TEXTURE_2D, id());
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glGetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_FLOAT, out.data());
-  glBindTexture(GL_TEXTURE_2D, 0);
-  checkGlError("image readback");
-  return out;
+  return readFloats(GL_RED, 1);
 }
 
 void GlTexture::uploadR32f(const std::vector<float>& values) {
   if (format_ != GL_R32F || values.size() != static_cast<std::size_t>(width_) * height_)
     throw Error("internal: uploadR32f needs an r32f texture and width*height floats");
-  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  glBindTexture(GL_TEXTURE_2D, id());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RED, GL_FLOAT, values.data());
-  glBindTexture(GL_TEXTURE_2D, 0);
-  checkGlError("image upload");
+  uploadFloats(GL_RED, values);
 }
 
 void GlTexture::uploadR32uiRows(const std::vector<std::uint32_t>& values) {

@@ -92,6 +92,9 @@ class GlTexture {
  private:
   // A new texture name of that size and format, without storage: what every create* starts from.
   static GlTexture generate(int width, int height, GLenum internalFormat);
+  // Whole-level float transfers behind read/upload*: pixel format GL_RGBA or GL_RED, row 0 first.
+  std::vector<float> readFloats(GLenum format, int channels) const;
+  void uploadFloats(GLenum format, const std::vector<float>& values);
   GlHandle handle_;
   int width_ = 0, height_ = 0;
   GLenum format_ = 0;

@@ -22,6 +22,24 @@ ShaderLibrary& library() {
   return lib;
 }
 
+// Renders on until `spp` samples per pixel, at most 64 per pass.
+void renderTo(Renderer& r, int spp) {
+  while (r.samplesPerPixel() < spp) r.renderPass(std::min(64, spp - r.samplesPerPixel()));
+}
+
+struct Reference {
+  Image image;
+  double noise;  // its own estimated relMSE
+};
+
+// The reference both comparisons measure against: `spp` samples with a seed no test render uses.
+Reference renderReference(const Scene& scene, const Camera& camera, RenderSettings rs, int spp) {
+  rs.seed = 1234567;
+  Renderer ref(library(), scene, camera, rs);
+  renderTo(ref, spp);
+  return {ref.image(), ref.errorEstimate().image};
+}
+
 struct EstimatePoint {
   int spp;
   double estimated, measured, referenceNoise;
@@ -38,16 +56,14 @@ std::vector<EstimatePoint> estimateAgainstReference(const std::string& file, int
   RenderSettings rs;
   rs.width = w;
   rs.height = h;
-  rs.seed = 1234567;
-  Renderer ref(library(), scene, camera, rs);
-  while (ref.samplesPerPixel() < referenceSpp) ref.renderPass(std::min(64, referenceSpp - ref.samplesPerPixel()));
-  const Image reference = ref.image();
-  const double referenceNoise = ref.errorEstimate().image;
+  const Reference ref = renderReference(scene, camera, rs, referenceSpp);
+  const Image& reference = ref.image;
+  const double referenceNoise = ref.noise;
   rs.seed = 1;
   Renderer r(library(), scene, camera, rs);
   std::vector<EstimatePoint> out;
   for (int spp : spps) {
-    while (r.samplesPerPixel() < spp) r.renderPass(std::min(64, spp - r.samplesPerPixel()));
+    renderTo(r, spp);
     out.push_back({spp, r.errorEstimate().image, relMse(r.image(), reference), referenceNoise});
     MESSAGE(file << " " << w << "x" << h << " at " << spp << " spp: estimated relMSE " << out.back().estimated
                   << ", measured " << out.back().measured << " (reference " << referenceSpp << " spp, its own "
@@ -81,18 +97,16 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
   RenderSettings rs;
   rs.width = w;
   rs.height = h;
-  rs.seed = 1234567;
-  Renderer ref(library(), scene, camera, rs);
-  while (ref.samplesPerPixel() < referenceSpp) ref.renderPass(std::min(64, referenceSpp - ref.samplesPerPixel()));
-  const Image reference = ref.image();
-  const double referenceNoise = ref.errorEstimate().image;
+  const Reference ref = renderReference(scene, camera, rs, referenceSpp);
+  const Image& reference = ref.image;
+  const double referenceNoise = ref.noise;
   std::vector<double> estimated(spps.size(), 0.0), measured(spps.size(), 0.0);
   std::vector<std::string> perSeed(spps.size());
   for (int seed = 1; seed <= seeds; ++seed) {
     rs.seed = static_cast<std::uint32_t>(seed);
     Renderer r(library(), scene, camera, rs);
     for (size_t k = 0; k < spps.size(); ++k) {
-      while (r.samplesPerPixel() < spps[k]) r.renderPass(std::min(64, spps[k] - r.samplesPerPixel()));
+      renderTo(r, spps[k]);
       const double e = r.errorEstimate().image, m = relMse(r.image(), reference) - referenceNoise;
       estimated[k] += e;
       measured[k] += m;
