@@ -72,6 +72,9 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     throw Error("this GPU's compute work groups are too small");
   settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
+  if (!scene.instances.empty())  // docs/instancing-status.md: the GPU path is not there yet
+    throw Error((scene.path.empty() ? std::string("scene") : scene.path) +
+                ": instanced scenes (LoadOptions::keepInstances) are not rendered yet; flattenInstances first");
 
   created_ = std::chrono::steady_clock::now();
   const auto since = [](std::chrono::steady_clock::time_point t) {

@@ -171,6 +171,12 @@ class SceneBuilder {
 
   // ---- meshes (gltf_nodes.cpp) ----
   void addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt);
+  // keepInstances: the mesh's triangles once in object space (on first use), then an Instance.
+  void addInstance(int meshIndex, const NodeTransform& xf, const std::string& nodeAt);
+  // EXT_mesh_gpu_instancing on a node: one local TRS matrix per instance (empty without the extension).
+  std::vector<glm::dmat4> gpuInstances(const tinygltf::Node& node, const std::string& at);
+  // A mesh placement (node world transform) as a MeshInstance, or skipped when singular.
+  void placeMesh(int mesh, const glm::dmat4& world, const std::string& at);
   void addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at);
 
   const std::string& path_;
@@ -205,6 +211,7 @@ class SceneBuilder {
   std::vector<CameraInstance> lightInstances_;  // same fields: `camera` holds the light index
   bool warnedRange_ = false;
   glm::dvec3 origin_{0.0};  // subtracted from every world position before it becomes float
+  std::map<int, std::uint32_t> storedMeshes_;  // keepInstances: glTF mesh -> Scene::meshes index
 };
 
 }  // namespace caustica::gltf

@@ -21,7 +21,7 @@ using Json = nlohmann::json;
 const char* const kSupportedExtensions[] = {
     "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
     "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_texture_transform",
-    "KHR_lights_punctual"};
+    "KHR_lights_punctual", "EXT_mesh_gpu_instancing"};
 
 std::string supportedExtensionList() {
   std::string out;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,7 +29,10 @@ void SceneBuilder::build() {
   origin_ = chooseOrigin();
   scene_.origin = origin_;
   for (const CameraInstance& c : cameraInstances_) addCamera(c.camera, c.world, model_.nodes[std::size_t(c.node)], c.at);
-  for (const MeshInstance& m : meshInstances_) addMesh(m.mesh, m.xf, m.at);
+  for (const MeshInstance& m : meshInstances_) {
+    if (options_.keepInstances) addInstance(m.mesh, m.xf, m.at);
+    else addMesh(m.mesh, m.xf, m.at);
+  }
   for (const CameraInstance& l : lightInstances_) addLight(l.camera, l.world, l.at);
   if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
   if (badNormals_ > 0)
@@ -39,8 +43,18 @@ void SceneBuilder::build() {
     if (why.empty()) why = "the default scene's nodes reference no mesh triangles";
     fail("the scene has no triangles to render (" + why + ")");
   }
-  for (const Triangle& t : scene_.triangles)
-    for (const glm::vec3& p : t.p) scene_.bounds.grow(p);
+  if (scene_.instances.empty()) {
+    for (const Triangle& t : scene_.triangles)
+      for (const glm::vec3& p : t.p) scene_.bounds.grow(p);
+  } else {
+    // The world-space vertices, as flattenInstances makes them (exact, not boxes of boxes).
+    for (const Instance& in : scene_.instances) {
+      const MeshRange& m = scene_.meshes[in.mesh];
+      for (std::uint32_t i = m.firstTriangle; i < m.firstTriangle + m.triangleCount; ++i)
+        for (const glm::vec3& p : scene_.triangles[i].p)
+          scene_.bounds.grow(glm::vec3(glm::dvec3(in.world * glm::dvec4(glm::dvec3(p), 1.0)) - origin_));
+    }
+  }
 }
 
 void SceneBuilder::warnUnsupportedExtensions() {
@@ -54,8 +68,13 @@ void SceneBuilder::checkTriangleCount() {
   // Saturating sums: a hostile file may declare counts near 2^53 on many instances.
   const std::uint64_t kSaturated = std::numeric_limits<std::uint64_t>::max() / 2;
   std::uint64_t total = 0;
+  std::set<int> counted;  // keepInstances: each mesh's triangles are stored once
+  if (options_.keepInstances && meshInstances_.size() > options_.maxTriangles)
+    fail("the scene places " + str(meshInstances_.size()) + " mesh instances, more than the limit of " +
+         str(options_.maxTriangles) + " (use --max-triangles to raise it)");
   for (const MeshInstance& m : meshInstances_) {
     if (m.mesh < 0 || std::size_t(m.mesh) >= model_.meshes.size()) continue;  // addMesh reports it
+    if (options_.keepInstances && !counted.insert(m.mesh).second) continue;
     for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(m.mesh)].primitives) {
       if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
           prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
@@ -184,18 +203,78 @@ void SceneBuilder::traverse() {
     if (node.camera >= 0) cameraInstances_.push_back({node.camera, index, xf.world, at});
     if (const int light = nodeLight(node); light >= 0) lightInstances_.push_back({light, index, xf.world, at});
     if (node.mesh >= 0) {
-      const glm::dmat3 m3(xf.world);
-      const double det = glm::determinant(m3);
-      if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) {
-        skip(at + ": its transform is singular (scale 0?); its mesh is skipped");
-      } else {
-        xf.normal = glm::transpose(glm::inverse(m3));
-        xf.flip = det < 0.0;
-        meshInstances_.push_back({node.mesh, xf, at});
-      }
+      const std::vector<glm::dmat4> gpu = gpuInstances(node, at);
+      if (gpu.empty()) placeMesh(node.mesh, xf.world, at);
+      for (std::size_t i = 0; i < gpu.size(); ++i)
+        placeMesh(node.mesh, xf.world * gpu[i], at + " (EXT_mesh_gpu_instancing instance " + str(i) + ")");
     }
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, xf.world);
   }
+}
+
+void SceneBuilder::placeMesh(int mesh, const glm::dmat4& world, const std::string& at) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(world[c][r])) fail(at + ": its world transform is not finite");
+  const glm::dmat3 m3(world);
+  const double det = glm::determinant(m3);
+  if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) {
+    skip(at + ": its transform is singular (scale 0?); its mesh is skipped");
+    return;
+  }
+  NodeTransform xf;
+  xf.world = world;
+  xf.normal = glm::transpose(glm::inverse(m3));
+  xf.flip = det < 0.0;
+  meshInstances_.push_back({mesh, xf, at});
+}
+
+// EXT_mesh_gpu_instancing: TRANSLATION (VEC3 float), ROTATION (VEC4 float or normalized
+// byte/short quaternion, x y z w) and SCALE (VEC3 float) accessors of equal count; each instance's
+// local matrix T * R * S is applied after the node's own world transform.
+std::vector<glm::dmat4> SceneBuilder::gpuInstances(const tinygltf::Node& node, const std::string& at) {
+  const auto it = node.extensions.find("EXT_mesh_gpu_instancing");
+  if (it == node.extensions.end() || !it->second.IsObject()) return {};
+  const std::string eat = at + ".extensions.EXT_mesh_gpu_instancing";
+  const tinygltf::Value& attributes = it->second.Get("attributes");
+  if (!attributes.IsObject()) fail(eat + " has no attributes object");
+  auto accessorOf = [&](const char* name) -> int {
+    const tinygltf::Value& v = attributes.Get(name);
+    if (!v.IsNumber() && !v.IsInt()) return -1;
+    return v.GetNumberAsInt();
+  };
+  const int ti = accessorOf("TRANSLATION"), ri = accessorOf("ROTATION"), si = accessorOf("SCALE");
+  if (ti < 0 && ri < 0 && si < 0) fail(eat + ".attributes has none of TRANSLATION, ROTATION, SCALE");
+  std::vector<double> t, r, s;
+  if (ti >= 0) t = readAccessor(ti, TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, eat + " TRANSLATION");
+  if (ri >= 0)
+    r = readAccessor(ri, TINYGLTF_TYPE_VEC4,
+                     {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}, {TINYGLTF_COMPONENT_TYPE_BYTE, true},
+                      {TINYGLTF_COMPONENT_TYPE_SHORT, true}},
+                     eat + " ROTATION");
+  if (si >= 0) s = readAccessor(si, TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, eat + " SCALE");
+  std::size_t count = ti >= 0 ? t.size() / 3 : ri >= 0 ? r.size() / 4 : s.size() / 3;
+  if ((ti >= 0 && t.size() / 3 != count) || (ri >= 0 && r.size() / 4 != count) || (si >= 0 && s.size() / 3 != count))
+    fail(eat + ": TRANSLATION, ROTATION and SCALE have different counts");
+  if (count > options_.maxTriangles)
+    fail(eat + " declares " + str(count) + " instances, more than the limit of " + str(options_.maxTriangles));
+  std::vector<glm::dmat4> out;
+  out.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    glm::dmat4 m(1.0);
+    if (ti >= 0) m = glm::translate(m, glm::dvec3(t[3 * i], t[3 * i + 1], t[3 * i + 2]));
+    if (ri >= 0) {
+      const glm::dquat q(r[4 * i + 3], r[4 * i], r[4 * i + 1], r[4 * i + 2]);
+      const double length = glm::length(q);
+      if (!(length > 1e-12) || !std::isfinite(length))
+        fail(eat + ": ROTATION of instance " + str(i) + " is not a unit quaternion");
+      m *= glm::mat4_cast(q / length);
+    }
+    if (si >= 0) m = glm::scale(m, glm::dvec3(s[3 * i], s[3 * i + 1], s[3 * i + 2]));
+    out.push_back(m);
+  }
+  if (out.empty()) warn(eat + " places no instances; the node's mesh is drawn once");
+  return out;
 }
 
 glm::dvec3 SceneBuilder::chooseOrigin() const {
@@ -275,6 +354,26 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
 }
 
 // ---- meshes ----
+void SceneBuilder::addInstance(int meshIndex, const NodeTransform& xf, const std::string& nodeAt) {
+  auto found = storedMeshes_.find(meshIndex);
+  if (found == storedMeshes_.end()) {
+    // Object space: identity transform and no rebasing (the instance carries both).
+    const std::size_t first = scene_.triangles.size();
+    const glm::dvec3 origin = origin_;
+    origin_ = glm::dvec3(0.0);
+    addMesh(meshIndex, NodeTransform{}, nodeAt);
+    origin_ = origin;
+    MeshRange range;
+    range.firstTriangle = std::uint32_t(first);
+    range.triangleCount = std::uint32_t(scene_.triangles.size() - first);
+    range.gltfMesh = meshIndex;
+    found = storedMeshes_.emplace(meshIndex, std::uint32_t(scene_.meshes.size())).first;
+    scene_.meshes.push_back(range);
+  }
+  if (scene_.meshes[found->second].triangleCount == 0) return;  // nothing to place
+  scene_.instances.push_back({found->second, xf.world});
+}
+
 void SceneBuilder::addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt) {
   if (std::size_t(meshIndex) >= model_.meshes.size())
     fail(nodeAt + ".mesh is " + str(std::uint64_t(meshIndex)) + ", but the file has " + str(model_.meshes.size()) +

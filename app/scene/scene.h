@@ -96,9 +96,29 @@ struct Bounds {
   bool empty() const { return min.x > max.x; }
 };
 
+// Instancing (docs/instancing-status.md). A mesh stored once, in its own (object) space:
+// Scene::triangles[firstTriangle, firstTriangle + triangleCount), in the file's winding.
+struct MeshRange {
+  std::uint32_t firstTriangle = 0;
+  std::uint32_t triangleCount = 0;
+  int gltfMesh = -1;  // index into the file's meshes, -1 when not from glTF
+};
+
+// One placement of a MeshRange. `world` maps object space to glTF world space (double, not rebased:
+// a world position becomes float as vec3(dvec3(world * p) - Scene::origin), as the loader does).
+struct Instance {
+  std::uint32_t mesh = 0;  // index into Scene::meshes
+  glm::dmat4 world{1.0};
+};
+
 struct Scene {
   std::string path;                  // file it was loaded from
+  // World-space triangles, or (when `instances` is not empty) the meshes' object-space triangles.
   std::vector<Triangle> triangles;
+  // Empty unless loaded with LoadOptions::keepInstances: then every triangle belongs to exactly one
+  // mesh and the scene is the union of its instances (flattenInstances makes it world space).
+  std::vector<MeshRange> meshes;
+  std::vector<Instance> instances;
   std::vector<Material> materials;   // never empty after loading (a default diffuse is added if needed)
   std::vector<Texture> textures;
   std::vector<Camera> cameras;       // perspective cameras in the default scene's node-visit order (may be empty)
@@ -134,7 +154,16 @@ struct LoadOptions {
   std::uint64_t maxTextureBytes = 1ull << 30;  // decoded RGBA8 texels of all images together
   std::uint64_t maxBufferBytes = 1ull << 30;   // sum of the buffers' declared byteLength
   std::uint64_t maxTriangles = 1ull << 24;     // triangles in the scene (GPU buffers: 112 B each)
+  // Keep each glTF mesh once in object space and its node (and EXT_mesh_gpu_instancing) placements
+  // as Scene::instances, instead of baking them into world-space copies. maxTriangles then bounds
+  // the stored (object-space) triangles, not the instanced ones.
+  bool keepInstances = false;
 };
+
+// Bakes an instanced scene (Scene::instances not empty) into world-space triangles, exactly as the
+// loader would have without keepInstances (same order, winding, normals; zero-area triangles
+// dropped), and empties meshes and instances. Does nothing to a scene without instances.
+void flattenInstances(Scene& scene);
 
 // Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const LoadOptions& options);

@@ -96,6 +96,20 @@ CAUSTICA_CONST uint kBvhFirstMask = 0x07ffffffu;  // first triangle of a leaf: <
 CAUSTICA_CONST uint kBvhMaxLeafSize = 15u;         // 4 bits of count
 CAUSTICA_CONST uint kBvhEmptyRef = 0x80000000u;    // a leaf of no triangles
 
+// Instancing (docs/instancing-status.md; not read by the shaders yet): one record per instance, in
+// top-level leaf order, 64 bytes = 4 RGBA32 texels, meant to follow the BVH nodes in their buffer
+// texture. The top-level BVH's leaves are single instances (count 1, first = record index); a
+// bottom-level BVH's nodes and triangles are rebased into the shared node and TriGeom arrays.
+struct InstanceRecord {
+  vec4 row0;      // world-to-object affine map, row 0: dot(row0.xyz, p) + row0.w
+  vec4 row1;      // row 1
+  vec4 row2;      // row 2 (normals back to world space: transpose of this 3x3, then normalize)
+  uint root;      // the mesh's bottom-level root node (index into the shared node array)
+  uint mesh;      // Scene::meshes index
+  uint sceneInstance;  // Scene::instances index
+  uint flags;     // 0 (reserved)
+};
+
 // Triangle positions for intersection (48 bytes).
 struct TriGeom {
   vec4 v0;  // xyz: vertex 0 (world space); w: material index (stored as float bits of a uint)
@@ -243,6 +257,7 @@ static_assert(sizeof(PointLights) == 16 + 64 * CAUSTICA_MAX_POINT_LIGHTS, "Point
 static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 64, "BvhNode must be 64 bytes (4 texels)");
+static_assert(sizeof(InstanceRecord) == 64, "InstanceRecord must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");

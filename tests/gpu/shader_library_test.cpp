@@ -148,7 +148,8 @@ TEST_CASE("the transparent-background variant (coverage image) compiles in both 
 
 TEST_CASE("the other entry shaders compile") {
   ShaderLibrary lib;
-  for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/twins_test.comp", "tests/environment_test.comp"}) {
+  for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/trace_instanced_test.comp", "tests/twins_test.comp",
+                            "tests/environment_test.comp"}) {
     std::string log = validate(lib.expand(entry, {}));
     INFO(entry);
     CHECK_MESSAGE(log.empty(), log);

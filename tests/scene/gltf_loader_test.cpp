@@ -1064,3 +1064,95 @@ TEST_CASE("untrusted input: raising a limit lets a hostile file past that check"
   CHECK(loadError(source("tests/data/bad/huge-accessor-count.gltf"), raised).find("overrun bufferViews[1]") !=
         std::string::npos);
 }
+
+TEST_CASE("instancing: keepInstances stores each mesh once; flattenInstances gives the flattened scene") {
+  TempDir dir;
+  Gltf g;
+  const float r = std::sqrt(0.5f);
+  // Mesh 0: two triangles with normals and texcoords; mesh 1: one emissive triangle without normals.
+  const int shaded = g.mesh({{"attributes",
+                              {{"POSITION", g.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0.5f, 0, 1, 0})},
+                               {"NORMAL", g.accessor(std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1, r, 0, r, r, 0, r, 0, r, r},
+                                                     kFloat, "VEC3")},
+                               {"TEXCOORD_0", g.accessor(std::vector<float>{0, 0, 1, 0, 0, 1, 1, 0, 1, 1, 0, 1},
+                                                         kFloat, "VEC2")}}},
+                             {"material", g.diffuse()}});
+  const int light = g.add("materials", {{"emissiveFactor", {1.0, 0.5, 0.25}}});
+  const int emitter = g.mesh({{"attributes", {{"POSITION", g.positions({0, 0, 0, 2, 0, 0, 0, 0, 2})}}},
+                              {"material", light}});
+  g.root({{"mesh", shaded}});
+  g.root({{"mesh", shaded}, {"scale", {-1.0, 2.0, 1.0}}, {"translation", {3, 0, 0}}});
+  g.root({{"mesh", emitter}, {"rotation", {0.0, 0.0, r, r}}, {"translation", {0, 4, 0}}});
+  const int parent = g.root({{"translation", {0, 0, -2}}, {"children", json::array()}});
+  const int t = g.accessor(std::vector<float>{0, 0, 0, 5, 0, 0, 0, 5, 0}, kFloat, "VEC3");
+  const int q = g.accessor(std::vector<float>{0, 0, 0, 1, 0, r, 0, r, 0, 0, 0, 1}, kFloat, "VEC4");
+  const int s3 = g.accessor(std::vector<float>{1, 1, 1, 1, 1, 1, 0.5f, 0.5f, 0.5f}, kFloat, "VEC3");
+  const int child = g.add("nodes", {{"mesh", emitter},
+                                    {"extensions", {{"EXT_mesh_gpu_instancing",
+                                                     {{"attributes", {{"TRANSLATION", t}, {"ROTATION", q}, {"SCALE", s3}}}}}}}});
+  g.doc["nodes"][std::size_t(parent)]["children"].push_back(child);
+  g.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  const std::string path = dir.write("instanced.gltf", g.text());
+
+  const Scene flat = caustica::loadScene(path);
+  caustica::LoadOptions keep;
+  keep.keepInstances = true;
+  Scene inst = caustica::loadScene(path, keep);
+  CHECK(flat.instances.empty());
+  REQUIRE(flat.triangles.size() == 2 + 2 + 1 + 3);
+  REQUIRE(inst.meshes.size() == 2);
+  CHECK(inst.triangles.size() == 3);  // each mesh once
+  CHECK(inst.instances.size() == 6);  // 3 nodes + 3 EXT_mesh_gpu_instancing instances
+  CHECK(inst.meshes[0].triangleCount == 2);
+  CHECK(inst.meshes[1].triangleCount == 1);
+  CHECK(caustica::sceneHasLights(inst));
+  CHECK(near(inst.bounds.min, flat.bounds.min));
+  CHECK(near(inst.bounds.max, flat.bounds.max));
+
+  caustica::flattenInstances(inst);
+  CHECK(inst.instances.empty());
+  CHECK(inst.meshes.empty());
+  REQUIRE(inst.triangles.size() == flat.triangles.size());
+  for (std::size_t i = 0; i < flat.triangles.size(); ++i) {
+    const caustica::Triangle& a = flat.triangles[i];
+    const caustica::Triangle& b = inst.triangles[i];
+    CAPTURE(i);
+    CHECK(a.material == b.material);
+    for (int k = 0; k < 3; ++k) {
+      CHECK(a.p[k] == b.p[k]);  // the same double arithmetic: bit for bit
+      CHECK(near(a.n[k], b.n[k]));
+      CHECK(a.uv[k] == b.uv[k]);
+    }
+  }
+  // EXT_mesh_gpu_instancing in the flattened scene: instance 1 is rotated 90 deg about y and moved by (5,0,0),
+  // instance 2 halved and moved by (0,5,0), all under the parent's (0,0,-2).
+  CHECK(near(flat.triangles[5].p[1], glm::vec3(2, 0, -2)));
+  CHECK(near(flat.triangles[6].p[1], glm::vec3(5, 0, -4)));
+  CHECK(near(flat.triangles[7].p[1], glm::vec3(1, 5, -2)));
+}
+
+TEST_CASE("instancing: limits count stored triangles; bad EXT_mesh_gpu_instancing is refused") {
+  TempDir dir;
+  Gltf g;
+  const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0})}}},
+                           {"material", g.diffuse()}});
+  for (int i = 0; i < 10; ++i) g.root({{"mesh", mesh}, {"translation", {double(i), 0.0, 0.0}}});
+  const std::string path = dir.write("ten.gltf", g.text());
+  caustica::LoadOptions opts;
+  opts.maxTriangles = 12;  // 20 flattened triangles; 2 stored, and 10 instances (also bounded by it)
+  CHECK_THROWS_AS(caustica::loadScene(path, opts), caustica::Error);
+  opts.keepInstances = true;
+  const Scene s = caustica::loadScene(path, opts);
+  CHECK(s.triangles.size() == 2);
+  CHECK(s.instances.size() == 10);
+  opts.maxTriangles = 9;
+  CHECK_THROWS_AS(caustica::loadScene(path, opts), caustica::Error);  // 10 instances
+
+  Gltf bad;
+  const int m = bad.mesh({{"attributes", {{"POSITION", bad.positions(kTriangle)}}}, {"material", bad.diffuse()}});
+  const int t = bad.accessor(std::vector<float>{0, 0, 0, 1, 0, 0}, kFloat, "VEC3");
+  const int sc = bad.accessor(std::vector<float>{1, 1, 1}, kFloat, "VEC3");
+  bad.root({{"mesh", m},
+            {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", t}, {"SCALE", sc}}}}}}}});
+  CHECK(loadError(dir.write("bad.gltf", bad.text())).find("different counts") != std::string::npos);
+}

@@ -1,0 +1,42 @@
+// tlas.h — instancing's two-level BVH (docs/instancing-status.md): one bottom-level BVH per mesh of
+// an instanced scene (Scene::meshes, object space, the ordinary builder), a top-level BVH over the
+// instances' world boxes, and the C++ traversal that moves the ray into an instance's object space at
+// a top-level leaf and back. Host side only so far: the GLSL twin and the renderer are the next step.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "shared/gpu_layout.h"
+#include "scene/scene.h"
+
+namespace caustica {
+
+struct InstancedBvh {
+  // nodes[0, topNodeCount): the top-level tree (root 0); then each mesh's bottom-level tree with its
+  // inner refs and leaf triangle indices rebased into `nodes` and `tris`.
+  std::vector<gpu::BvhNode> nodes;
+  std::uint32_t topNodeCount = 0;
+  std::vector<gpu::TriGeom> tris;            // object space, each mesh in its own leaf order
+  std::vector<std::uint32_t> triSource;      // tris index -> Scene::triangles index
+  std::vector<gpu::InstanceRecord> instances;  // top-level leaf order
+  std::vector<std::uint32_t> meshRoot;       // Scene::meshes index -> its root node in `nodes`
+  int depth = 0;                             // top-level depth + deepest bottom-level depth
+};
+
+// Builds from a scene with instances (throws caustica::Error for one without). Instances are placed
+// with the float world-to-object matrix of (Scene::origin-rebased) Instance::world.
+InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& options = {});
+
+struct InstancedHit {
+  Hit hit;                                         // t in world units of the ray's dir; hit.tri indexes tris
+  std::uint32_t instance = gpu::kInvalidIndex;     // Scene::instances index
+};
+
+// Closest hit with t in (0, tmax): twin-to-be of the GLSL traversal.
+InstancedHit traceClosest(const InstancedBvh& bvh, const Ray& ray, float tmax = std::numeric_limits<float>::infinity());
+// Any hit with t in (0, tmax).
+bool traceOccluded(const InstancedBvh& bvh, const Ray& ray, float tmax);
+
+}  // namespace caustica
