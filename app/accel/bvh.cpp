@@ -11,6 +11,7 @@
 #include <cmath>
 #include <string>
 
+#include "accel/ray_box.h"
 #include "accel/spawn.h"
 #include "util/error.h"
 
@@ -579,35 +580,9 @@ bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
 
 namespace {
 
-constexpr float kDirTiny = 1e-20f;
-// Relative widening of a box's exit distance: covers the rounding of the slab distances and of t.
-constexpr float kBoxPad = 1.0f + 1.0f / (1 << 20);
-constexpr float kBig = 3.0e38f;
-
-// Guarded reciprocal: |d| < 1e-20 becomes +-1e-20 (sign by d >= 0, as in GLSL), so never inf or NaN.
-inline glm::vec3 safeInverse(const glm::vec3& d) {
-  glm::vec3 r;
-  for (int a = 0; a < 3; ++a) {
-    const float g = std::fabs(d[a]) < kDirTiny ? (d[a] >= 0.0f ? kDirTiny : -kDirTiny) : d[a];
-    r[a] = 1.0f / g;
-  }
-  return r;
-}
-
-// Slab test; twin of intersectAabb() in intersect.glsl. tnear: entry distance clamped to >= 0.
-// An exit distance of exactly 0 (origin on a slab plane with a guarded ~0 direction component)
-// is treated as "inside" so that rays lying on a box face still visit it; this is conservative.
-inline bool intersectAabb(const glm::vec3& org, const glm::vec3& invDir, const glm::vec3& bmin,
-                          const glm::vec3& bmax, float tmax, float& tnear) {
-  const glm::vec3 t0 = (bmin - org) * invDir;
-  const glm::vec3 t1 = (bmax - org) * invDir;
-  const glm::vec3 lo = glm::min(t0, t1);
-  glm::vec3 hi = glm::max(t0, t1);
-  for (int a = 0; a < 3; ++a) hi[a] = hi[a] == 0.0f ? kBig : hi[a];
-  tnear = std::max(std::max(lo.x, lo.y), std::max(lo.z, 0.0f));
-  const float tfar = std::min(std::min(hi.x, hi.y), std::min(hi.z, tmax)) * kBoxPad;
-  return tnear <= tfar;
-}
+using raybox::intersectAabb;
+using raybox::kBoxPad;
+using raybox::safeInverse;
 
 // Traversal shared by closest and any hit, in the GLSL twin's order: near child first, the far one on
 // a fixed-size stack with its entry distance; a popped subtree that starts beyond the closest hit is

@@ -5,38 +5,17 @@
 #include <cmath>
 #include <string>
 
+#include "accel/ray_box.h"
 #include "util/error.h"
 
 namespace caustica {
 
 namespace {
 
-// The same guards as bvh.cpp's traversal (kept equal: the GLSL twin will share them).
-constexpr float kDirTiny = 1e-20f;
-constexpr float kBoxPad = 1.0f + 1.0f / (1 << 20);
-constexpr float kBig = 3.0e38f;
+using raybox::intersectAabb;
+using raybox::kBoxPad;
+using raybox::safeInverse;
 constexpr int kStack = 2 * CAUSTICA_BVH_STACK;  // one tree on top of the other
-
-glm::vec3 safeInverse(const glm::vec3& d) {
-  glm::vec3 r;
-  for (int a = 0; a < 3; ++a) {
-    const float g = std::fabs(d[a]) < kDirTiny ? (d[a] >= 0.0f ? kDirTiny : -kDirTiny) : d[a];
-    r[a] = 1.0f / g;
-  }
-  return r;
-}
-
-bool intersectAabb(const glm::vec3& org, const glm::vec3& invDir, const glm::vec3& bmin, const glm::vec3& bmax,
-                   float tmax, float& tnear) {
-  const glm::vec3 t0 = (bmin - org) * invDir;
-  const glm::vec3 t1 = (bmax - org) * invDir;
-  const glm::vec3 lo = glm::min(t0, t1);
-  glm::vec3 hi = glm::max(t0, t1);
-  for (int a = 0; a < 3; ++a) hi[a] = hi[a] == 0.0f ? kBig : hi[a];
-  tnear = std::max(std::max(lo.x, lo.y), std::max(lo.z, 0.0f));
-  const float tfar = std::min(std::min(hi.x, hi.y), std::min(hi.z, tmax)) * kBoxPad;
-  return tnear <= tfar;
-}
 
 std::uint32_t rebase(std::uint32_t ref, std::uint32_t nodeOffset, std::uint32_t triOffset) {
   if ((ref & gpu::kBvhLeafBit) == 0) return ref + nodeOffset;

@@ -10,11 +10,6 @@
 
 const int kInstancedStack = 2 * CAUSTICA_BVH_STACK;
 
-struct InstancedTraceState {
-  vec3 org, dir, invDir;
-  RayShear rs;
-};
-
 // World-to-object rows of record `record`, and its bottom-level root (texel 3 .x).
 void instanceRecord(uint recordBase, uint record, out vec4 r0, out vec4 r1, out vec4 r2, out uint root, out uint sceneInstance) {
   int base = int(4u * (recordBase + record));
