@@ -189,17 +189,20 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
       if (depth + 1u < maxDepth) {
         radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
       }
+      // The environment's and the punctual lights' numbers are drawn in every shader variant, with the
+      // feature or without: all variants then draw the same random numbers for the same path, so the
+      // all-features shader renders the specialised shader's image to float rounding (a test compares).
+      vec2 uEnv = rand2(rng);
 #ifdef CAUSTICA_ENV
       // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
       // Not inside an absorbing medium: the ray could only leave through its boundary.
-      vec2 uEnv = rand2(rng);
       if (depth + 1u < maxDepth && sigma == vec3(0.0)) radiance += beta * filt * addEnvironmentLight(v, uEnv);
 #endif
 #endif
+      float uPunctual = rand01(rng);
 #ifdef CAUSTICA_PUNCTUAL
       // Punctual lights: their own estimate, added to the emitters' (a sum of unbiased estimates);
       // in both integrators, since a bounce never finds a delta light.
-      float uPunctual = rand01(rng);
       if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(v, uPunctual);
 #endif
 #ifdef CAUSTICA_CASTERS
@@ -245,15 +248,17 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_MIS
       if (depth + 1u < maxDepth) radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
 #endif
-#if defined(CAUSTICA_ENV) && defined(CAUSTICA_MIS)
+#ifdef CAUSTICA_MIS
+      vec2 uEnv = rand2(rng);  // drawn with or without the feature, as at diffuse vertices
+#ifdef CAUSTICA_ENV
       // The environment's next-event estimate through this lobe (both sides for rough glass), matching
       // the MIS weight escaped rays get after this vertex (environment_light.glsl).
-      vec2 uEnv = rand2(rng);
       if (depth + 1u < maxDepth)
         radiance += beta * filt * addEnvironmentLight(v, uEnv);
 #endif
-#ifdef CAUSTICA_PUNCTUAL
+#endif
       float uPunctual = rand01(rng);
+#ifdef CAUSTICA_PUNCTUAL
       if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(v, uPunctual);
 #endif
       BsdfSample bs;

@@ -2,11 +2,25 @@
 #include "gpu/adaptive_sampler.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <string>
+
+#include "util/error.h"
 
 namespace caustica {
 
-AdaptiveSampler::AdaptiveSampler(double targetError, bool adaptive, int minSpp)
-    : target_(targetError), adaptive_(adaptive), minSpp_(std::max(2, minSpp)) {}
+int defaultAdaptiveTile() {
+  const char* v = std::getenv("CAUSTICA_ADAPTIVE_TILE");
+  if (v == nullptr || *v == '\0') return kAdaptiveTile;
+  const std::string s(v);
+  if (s == "1" || s == "2" || s == "4" || s == "8") return std::stoi(s);
+  throw Error("CAUSTICA_ADAPTIVE_TILE must be 1, 2, 4 or 8, not '" + s + "'");
+}
+
+AdaptiveSampler::AdaptiveSampler(double targetError, bool adaptive, int minSpp, int tileSize)
+    : target_(targetError), adaptive_(adaptive), minSpp_(std::max(2, minSpp)), tileSize_(tileSize) {
+  if (tileSize != 1 && tileSize != 2 && tileSize != 4 && tileSize != 8) throw Error("adaptive tile size must be 1, 2, 4 or 8");
+}
 
 int AdaptiveSampler::checkAtOrAfter(int spp) const {
   int c = minSpp_;
@@ -15,11 +29,11 @@ int AdaptiveSampler::checkAtOrAfter(int spp) const {
 }
 
 const ErrorEstimate& AdaptiveSampler::check(Renderer& renderer) {
-  estimate_ = renderer.errorEstimate();
+  estimate_ = renderer.errorEstimate(tileSize_);
   liveTiles_ = renderer.liveTileCount();
   if (adaptive_) {
     std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, kMaxSppRatio, kTileDilation);
-    renderer.setLiveTiles(live);
+    renderer.setLiveTiles(live, tileSize_);
     liveTiles_ = live.size();
   }
   done_ = estimate_.image <= target_ || (adaptive_ && liveTiles_ == 0);

@@ -12,12 +12,18 @@ namespace caustica {
 constexpr int kMinAdaptiveSpp = 16;  // no tile stops before every pixel has this many samples
 constexpr int kTileDilation = 1;     // a tile with over 4x the mean gain keeps its 8 neighbours live
 constexpr int kMaxSppRatio = 8;      // no tile falls behind the most sampled one by more than this factor
+constexpr int kAdaptiveTile = 8;     // side of the tiles in pixels (1, 2, 4 or 8; docs/adaptive-sampling.md)
+
+// kAdaptiveTile, or the environment variable CAUSTICA_ADAPTIVE_TILE (1, 2, 4 or 8) where set: a knob
+// to measure other tile sizes with (docs/benchmarks.md, "Adaptive sampling"). Throws Error otherwise.
+int defaultAdaptiveTile();
 
 class AdaptiveSampler {
  public:
   // `targetError`: relMSE at which the render is done (> 0), `adaptive`: whether only the tiles whose
   // error falls fastest receive samples (liveTiles in error_estimate.h), else every tile does.
-  AdaptiveSampler(double targetError, bool adaptive, int minSpp = kMinAdaptiveSpp);
+  // `tileSize`: side of the tiles in pixels (1, 2, 4 or 8).
+  AdaptiveSampler(double targetError, bool adaptive, int minSpp = kMinAdaptiveSpp, int tileSize = defaultAdaptiveTile());
 
   // The first scheduled check at `spp` or above: minSpp, then each previous one + max(4, previous / 8).
   int checkAtOrAfter(int spp) const;
@@ -29,11 +35,13 @@ class AdaptiveSampler {
   std::size_t liveTiles() const { return liveTiles_; }
   double targetError() const { return target_; }
   bool adaptive() const { return adaptive_; }
+  int tileSize() const { return tileSize_; }
 
  private:
   double target_;
   bool adaptive_;
   int minSpp_;
+  int tileSize_;
   ErrorEstimate estimate_;
   std::size_t liveTiles_ = 0;
   bool done_ = false;

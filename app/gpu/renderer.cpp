@@ -271,11 +271,18 @@ void Renderer::renderPass(int spp) {
   endPass(spp);
 }
 
-void Renderer::setLiveTiles(const std::vector<std::uint32_t>& tiles) {
+void Renderer::setLiveTiles(const std::vector<std::uint32_t>& tiles, int tileSize) {
+  if (tileSize != 1 && tileSize != 2 && tileSize != 4 && tileSize != 8) throw Error("internal: adaptive tile size must be 1, 2, 4 or 8");
+  const std::size_t all = static_cast<std::size_t>((settings_.width + tileSize - 1) / tileSize) *
+                          static_cast<std::size_t>((settings_.height + tileSize - 1) / tileSize);
+  if (tiles.size() > all) throw Error("internal: more live tiles than the image has");
   const std::size_t capacity = static_cast<std::size_t>(tileList_.width()) * static_cast<std::size_t>(tileList_.height());
-  if (tiles.size() > capacity) throw Error("internal: more live tiles than the image has");
+  if (all > capacity)  // smaller tiles than the list was made for (allocateImages: 8x8)
+    tileList_ = GlTexture::create2D(CAUSTICA_TILE_LIST_WIDTH, static_cast<int>((all + CAUSTICA_TILE_LIST_WIDTH - 1) / CAUSTICA_TILE_LIST_WIDTH),
+                                    GL_R32UI);
   tileList_.uploadR32uiRows(tiles);
   liveTiles_ = static_cast<std::uint32_t>(tiles.size());
+  liveTileSize_ = tileSize;
   tileListActive_ = true;
 }
 
@@ -290,9 +297,9 @@ std::size_t Renderer::liveTileCount() const {
          static_cast<std::size_t>((settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
 }
 
-ErrorEstimate Renderer::errorEstimate() const {
+ErrorEstimate Renderer::errorEstimate(int tileSize) const {
   return estimateError(settings_.width, settings_.height, accum_.readRgba32f(), comp_.readRgba32f(), half_.readRgba32f(),
-                       CAUSTICA_WORKGROUP_X);
+                       tileSize);
 }
 
 // One dispatch per sample: rows [y0, y1), or with `tiles` one work group per live tile.
@@ -310,7 +317,6 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   fp.camUp = glm::vec4(up * tanHalf, 0.0f);
   fp.camForward = glm::vec4(fwd, 0.0f);
   fp.tile = glm::uvec4(0, y0, w, y1 - y0);
-  fp.lights = glm::vec4(gpuScene_.totalEmitterWeight, 0.0f, 0.0f, 0.0f);
 
   prog.use();
   for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
@@ -332,17 +338,20 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
   // (a sample traces at most 2 * maxDepth + 1 rays, plus one per alpha pass-through: at most 256).
   const std::uint64_t pixelsPerDispatch =
-      tiles ? std::uint64_t(liveTiles_) * CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y
+      tiles ? std::uint64_t(liveTiles_) * std::uint64_t(liveTileSize_ * liveTileSize_)
             : static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0);
   const std::uint64_t raysPerDispatch = pixelsPerDispatch * (2u * settings_.maxDepth + 1u + 256u);
-  // Tile lists: a 2D grid of work groups, since one dimension may hold only 65535 of them.
-  const GLuint groupsX = tiles ? std::min<GLuint>(liveTiles_, 65535u) : GLuint((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X);
-  const GLuint groupsY = tiles ? (liveTiles_ + groupsX - 1) / groupsX : GLuint((y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
+  // Tile lists: one work group per 64 / tileSize^2 live tiles (adaptive.glsl), on a 2D grid, since one
+  // dimension may hold only 65535 groups.
+  const GLuint tilesPerGroup = GLuint(CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y / (liveTileSize_ * liveTileSize_));
+  const GLuint liveGroups = (liveTiles_ + tilesPerGroup - 1) / tilesPerGroup;
+  const GLuint groupsX = tiles ? std::min<GLuint>(liveGroups, 65535u) : GLuint((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X);
+  const GLuint groupsY = tiles ? (liveGroups + groupsX - 1) / groupsX : GLuint((y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
   const int dispatchesPerRead = static_cast<int>(std::max<std::uint64_t>(1, (1ull << 31) / raysPerDispatch));
   for (int s = 0; s < spp; ++s) {
     if (s > 0 && s % dispatchesPerRead == 0) readCounters();
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), 0u);
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), GLuint(liveTileSize_));
     frameUbo_.update(0, sizeof fp, &fp);
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);

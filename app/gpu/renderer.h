@@ -78,14 +78,16 @@ class Renderer {
   // Adds `spp` samples to every pixel, or under adaptive sampling (setLiveTiles) to the live tiles only.
   void renderPass(int spp);
 
-  // Adaptive sampling: from now on renderPass samples only these 8x8 tiles (packed x | y << 16, as
-  // liveTiles() returns them); an empty list samples nothing. useAllTiles() (and any reset) ends it.
-  void setLiveTiles(const std::vector<std::uint32_t>& tiles);
+  // Adaptive sampling: from now on renderPass samples only these tiles of tileSize x tileSize pixels
+  // (packed x | y << 16 in tiles, as liveTiles() returns them; tileSize 1, 2, 4 or 8: one 8x8 work
+  // group samples 64 / tileSize^2 tiles); an empty list samples nothing. useAllTiles() (and any reset) ends it.
+  void setLiveTiles(const std::vector<std::uint32_t>& tiles, int tileSize = CAUSTICA_WORKGROUP_X);
   void useAllTiles();
   bool adaptive() const { return tileListActive_; }
-  std::size_t liveTileCount() const;  // tiles renderPass samples
-  // The error estimate of the image so far (reads three images back; error_estimate.h).
-  ErrorEstimate errorEstimate() const;
+  std::size_t liveTileCount() const;  // tiles renderPass samples (of the last setLiveTiles' size, else 8x8)
+  // The error estimate of the image so far, per tile of tileSize x tileSize pixels (reads three images
+  // back; error_estimate.h).
+  ErrorEstimate errorEstimate(int tileSize = CAUSTICA_WORKGROUP_X) const;
 
   int samplesPerPixel() const { return spp_; }
   // Reads back both accumulation images and the sample counters (for checkpoints).
@@ -146,6 +148,7 @@ class Renderer {
   bool transparent_ = false;  // the scene's background is transparent: coverage_ exists
   GlTexture coverage_;        // r32f camera-ray hits per pixel (CAUSTICA_IMAGE_COVERAGE), if transparent_
   std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_
+  int liveTileSize_ = CAUSTICA_WORKGROUP_X;  // side of those tiles in pixels
   bool tileListActive_ = false;
   std::map<std::string, GlProgram> programs_;
   GlProgram tonemapProgram_;

@@ -1,5 +1,5 @@
 // adaptive.glsl — which pixel an invocation renders: the rows of FrameParams.tile (uniform passes), or
-// under adaptive sampling one 8x8 work group per live tile read from the tile list (CAUSTICA_IMAGE_TILES).
+// under adaptive sampling a live tile (side options.w: 1-8 pixels) read from the tile list (CAUSTICA_IMAGE_TILES).
 
 layout(r32ui, binding = CAUSTICA_IMAGE_TILES) uniform restrict readonly uimage2D tileList;
 
@@ -11,11 +11,17 @@ bool dispatchedPixel(out uvec2 pixel) {
     pixel = local + frame.tile.xy;
     return all(lessThan(local, frame.tile.zw)) && all(lessThan(pixel, frame.frame.xy));
   }
-  uint index = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;  // 2D grid past 65535 groups
+  // Adaptive: each work group samples 64 / side^2 consecutive entries of the tile list, side^2
+  // invocations per tile (side 8: one tile, the invocation's local position in it).
+  uint side = frame.options.w;
+  uint perTile = side * side;
+  uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;  // 2D grid past 65535 groups
+  uint index = group * (uint(CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y) / perTile) + gl_LocalInvocationIndex / perTile;
+  uint within = gl_LocalInvocationIndex % perTile;
   uint entry = index < liveTiles
                     ? imageLoad(tileList, ivec2(index % CAUSTICA_TILE_LIST_WIDTH, index / CAUSTICA_TILE_LIST_WIDTH)).r
                     : 0u;
   uvec2 tile = uvec2(entry & 0xffffu, entry >> 16u);
-  pixel = tile * uvec2(CAUSTICA_WORKGROUP_X, CAUSTICA_WORKGROUP_Y) + gl_LocalInvocationID.xy;
+  pixel = tile * side + uvec2(within % side, within / side);
   return index < liveTiles && all(lessThan(pixel, frame.frame.xy));
 }

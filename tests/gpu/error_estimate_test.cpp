@@ -188,6 +188,42 @@ Scene unevenNoiseScene() {
 
 }  // namespace
 
+// The tile list's dispatch covers exactly the listed tiles, at every tile size: one pass adds one
+// sample to each pixel of a listed tile (edge tiles clipped to the image) and none elsewhere. 21x13
+// pixels: the last column and row of tiles are partial at every size but 1.
+TEST_CASE("adaptive sampling: a pass samples exactly the pixels of the listed tiles, tiles of 1, 2, 4 and 8") {
+  Scene scene = unevenNoiseScene();
+  Camera camera = sceneCamera(scene);
+  RenderSettings rs;
+  rs.width = 21;
+  rs.height = 13;
+  for (int side : {1, 2, 4, 8}) {
+    Renderer r(library(), scene, camera, rs);
+    const int tx = (rs.width + side - 1) / side, ty = (rs.height + side - 1) / side;
+    // Every third tile in row-major order, and the last (bottom-right, partial) one.
+    std::vector<std::uint32_t> list;
+    std::vector<char> listed(static_cast<size_t>(tx) * ty, 0);
+    for (int t = 0; t < tx * ty; ++t)
+      if (t % 3 == 1 || t == tx * ty - 1) {
+        list.push_back(static_cast<std::uint32_t>(t % tx) | (static_cast<std::uint32_t>(t / tx) << 16));
+        listed[static_cast<size_t>(t)] = 1;
+      }
+    r.setLiveTiles(list, side);
+    CHECK(r.liveTileCount() == list.size());
+    r.renderPass(1);
+    r.renderPass(1);
+    const AccumulationState st = r.saveAccumulation();
+    int wrong = 0;
+    for (int y = 0; y < rs.height; ++y)
+      for (int x = 0; x < rs.width; ++x) {
+        const float expected = listed[static_cast<size_t>(y / side) * tx + x / side] ? 2.0f : 0.0f;
+        if (st.accum[(static_cast<size_t>(y) * rs.width + x) * 4 + 3] != expected) ++wrong;
+      }
+    INFO("tile side " << side << ": " << list.size() << " of " << tx * ty << " tiles listed");
+    CHECK(wrong == 0);
+  }
+}
+
 // Adaptive sampling stops converged tiles; the tiles it keeps sampling get the same samples as a
 // uniform render's, so both converge to the same image. 48x48 (36 tiles): the emitter's tiles pause,
 // the wall's keep sampling. Each quadrant's means must agree within 3 standard deviations of their
@@ -207,56 +243,65 @@ TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
   Renderer uniform(library(), scene, camera, rs);
   while (uniform.samplesPerPixel() < 3072) uniform.renderPass(64);
   const ErrorEstimate eu = uniform.errorEstimate();
-  rs.seed = 6;
-  Renderer adaptive(library(), scene, camera, rs);
-  AdaptiveSampler sampler(eu.image, true);
-  int next = sampler.checkAtOrAfter(0);
-  while (!sampler.done() && adaptive.samplesPerPixel() < 16384) {
-    adaptive.renderPass(next - adaptive.samplesPerPixel());
-    sampler.check(adaptive);
-    next = sampler.checkAtOrAfter(adaptive.samplesPerPixel() + 1);
-  }
-  const ErrorEstimate ea = adaptive.errorEstimate();
-  MESSAGE("uniform: " << eu.sppMean << " spp, relMSE~" << eu.image << "; adaptive: spp " << ea.sppMin << ".."
-                      << ea.sppMax << " (mean " << ea.sppMean << "), relMSE~" << ea.image << ", live tiles "
-                      << sampler.liveTiles());
-  CHECK(sampler.done());
-  CHECK(ea.sppMin < ea.sppMax);  // some tiles did stop early: the test exercises the tile list
-  CHECK(ea.sppMin >= kMinAdaptiveSpp);
-  const Image a = adaptive.image(), u = uniform.image();
-  for (int qy = 0; qy < 2; ++qy)
-    for (int qx = 0; qx < 2; ++qx) {
-      // Variance of a quadrant's channel-averaged mean from the per-pixel estimates: the sum of
-      // relMSE * (m^2 + eps) / n^2. The channels of a grey scene's sample are equal, so the channel
-      // average has each channel's variance (no / 3; it is an upper bound when they differ).
-      auto quadrantVar = [&](const ErrorEstimate& e, const Image& img) {
-        double v = 0.0;
-        int n = 0;
-        for (int y = qy * 24; y < qy * 24 + 24; ++y)
-          for (int x = qx * 24; x < qx * 24 + 24; ++x, ++n) {
-            double m = (img.at(x, y, 0) + img.at(x, y, 1) + img.at(x, y, 2)) / 3.0;
-            v += e.pixel[static_cast<size_t>(y) * 48 + x] * (m * m + kErrorEpsilon);
-          }
-        return v / (double(n) * n);
-      };
-      const double ma = quadrantMean(a, qx, qy), mu = quadrantMean(u, qx, qy);
-      const double sd = std::sqrt(quadrantVar(ea, a) + quadrantVar(eu, u));
-      MESSAGE("quadrant " << qx << "," << qy << ": adaptive " << ma << ", uniform " << mu << ", sd of the difference "
-                          << sd << " (" << 100.0 * sd / mu << " %)");
-      CHECK(3.0 * sd <= 0.005 * mu);  // the test can see a 0.5 % bias (measured: sd 0.1 % and 0.16 %)
-      CHECK(std::abs(ma - mu) <= 3.0 * sd);
+  for (int side : {8, 4}) {
+    INFO("adaptive tiles of " << side << "x" << side);
+    rs.seed = 6;
+    Renderer adaptive(library(), scene, camera, rs);
+    AdaptiveSampler sampler(eu.image, true, kMinAdaptiveSpp, side);
+    int next = sampler.checkAtOrAfter(0);
+    while (!sampler.done() && adaptive.samplesPerPixel() < 16384) {
+      adaptive.renderPass(next - adaptive.samplesPerPixel());
+      sampler.check(adaptive);
+      next = sampler.checkAtOrAfter(adaptive.samplesPerPixel() + 1);
     }
+    const ErrorEstimate ea = adaptive.errorEstimate();
+    MESSAGE("tiles " << side << ": uniform: " << eu.sppMean << " spp, relMSE~" << eu.image << "; adaptive: spp " << ea.sppMin << ".."
+                        << ea.sppMax << " (mean " << ea.sppMean << "), relMSE~" << ea.image << ", live tiles "
+                        << sampler.liveTiles());
+    CHECK(sampler.done());
+    CHECK(ea.sppMin < ea.sppMax);  // some tiles did stop early: the test exercises the tile list
+    CHECK(ea.sppMin >= kMinAdaptiveSpp);
+    const Image a = adaptive.image(), u = uniform.image();
+    for (int qy = 0; qy < 2; ++qy)
+      for (int qx = 0; qx < 2; ++qx) {
+        // Variance of a quadrant's channel-averaged mean from the per-pixel estimates: the sum of
+        // relMSE * (m^2 + eps) / n^2. The channels of a grey scene's sample are equal, so the channel
+        // average has each channel's variance (no / 3; it is an upper bound when they differ).
+        auto quadrantVar = [&](const ErrorEstimate& e, const Image& img) {
+          double v = 0.0;
+          int n = 0;
+          for (int y = qy * 24; y < qy * 24 + 24; ++y)
+            for (int x = qx * 24; x < qx * 24 + 24; ++x, ++n) {
+              double m = (img.at(x, y, 0) + img.at(x, y, 1) + img.at(x, y, 2)) / 3.0;
+              v += e.pixel[static_cast<size_t>(y) * 48 + x] * (m * m + kErrorEpsilon);
+            }
+          return v / (double(n) * n);
+        };
+        const double ma = quadrantMean(a, qx, qy), mu = quadrantMean(u, qx, qy);
+        const double sd = std::sqrt(quadrantVar(ea, a) + quadrantVar(eu, u));
+        MESSAGE("quadrant " << qx << "," << qy << ": adaptive " << ma << ", uniform " << mu << ", sd of the difference "
+                            << sd << " (" << 100.0 * sd / mu << " %)");
+        CHECK(3.0 * sd <= 0.005 * mu);  // the test can see a 0.5 % bias (measured: sd 0.1 % and 0.16 %)
+        CHECK(std::abs(ma - mu) <= 3.0 * sd);
+      }
+  }
 }
 
 // The all-features shader (--all-features, docs/benchmarks.md "Specialisation") renders the image of
-// the specialised one: features a scene lacks must change nothing but speed. Each quadrant's mean of
-// two renders (other seeds) agrees within 4 standard deviations of the difference, predicted from the
-// per-pixel estimates as in the test above (measured at 32x32, 256 spp: sd 0.4-0.5 % of the mean in
-// the lower quadrants, 1.9-3.7 % in the upper ones with the light's edge; differences 0.2-1.5 sd). A
-// gross error of a feature the scene lacks (an absent environment lighting it, say) fails; seen
-// failing with the all-features image's means scaled by 1.1.
+// the specialised one: features a scene lacks must change nothing but speed. Both shaders draw the
+// same random numbers for the same path (pathtrace.comp draws the environment's and the punctual
+// lights' numbers in every variant), so with the same seed they trace the same paths and the images
+// agree to float rounding, save the rare path that a rounding difference sends another way.
+// Measured on llvmpipe (32x32, 64 spp, seed 11): the images are bit for bit equal on all three
+// scenes (largest pixel difference 0); the tolerances leave room for another compiler's rounding.
+// Seen failing with the all-features shader's radiance scaled by 1.005 (under CAUSTICA_PUNCTUAL):
+// 1022-1024 of 1024 pixels differ by more than 1e-3 and every quadrant's mean by 0.5 %.
 TEST_CASE("the all-features shader renders the specialised shader's image") {
-  for (const char* file : {"assets/scenes/cornell-box.gltf", "tests/data/scenes/small-cornell.gltf"}) {
+  // Relative differences allowed: of a quadrant's mean, and of a pixel (beyond which a pixel counts
+  // as "diverged": a path sent another way by rounding).
+  constexpr double kMaxMeanDiff = 1e-3, kMaxPixelDiff = 1e-3;
+  for (const char* file : {"assets/scenes/cornell-box.gltf", "tests/data/scenes/small-cornell.gltf",
+                           "assets/scenes/cornell-glass.gltf"}) {
     Scene scene = loadScene(sourcePath(file));
     Camera camera = sceneCamera(scene);
     RenderSettings rs;
@@ -264,31 +309,32 @@ TEST_CASE("the all-features shader renders the specialised shader's image") {
     rs.height = 32;
     rs.seed = 11;
     Renderer specialised(library(), scene, camera, rs);
-    rs.seed = 12;
     rs.allFeatures = true;
     Renderer all(library(), scene, camera, rs);
     CHECK(all.shaderDefines().size() > specialised.shaderDefines().size());
-    while (specialised.samplesPerPixel() < 256) specialised.renderPass(64);
-    while (all.samplesPerPixel() < 256) all.renderPass(64);
-    const ErrorEstimate es = specialised.errorEstimate(), ea = all.errorEstimate();
+    specialised.renderPass(64);
+    all.renderPass(64);
     const Image is = specialised.image(), ia = all.image();
+    int diverged = 0;
+    double worst = 0.0;
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x) {
+        double d = 0.0;
+        for (int c = 0; c < 3; ++c)
+          d = std::max(d, std::abs(ia.at(x, y, c) - is.at(x, y, c)) / (std::abs(is.at(x, y, c)) + 1e-3));
+        worst = std::max(worst, d);
+        if (d > kMaxPixelDiff) ++diverged;
+      }
+    MESSAGE(std::string(file) << ": pixels differing by more than " << kMaxPixelDiff << ": " << diverged << " of 1024, largest "
+                 << worst);
+    CHECK(diverged <= 10);  // about 1 %
     for (int qy = 0; qy < 2; ++qy)
       for (int qx = 0; qx < 2; ++qx) {
-        auto quadrantVar = [&](const ErrorEstimate& e, const Image& img) {
-          double v = 0.0;
-          for (int y = qy * 16; y < qy * 16 + 16; ++y)
-            for (int x = qx * 16; x < qx * 16 + 16; ++x) {
-              double m = (img.at(x, y, 0) + img.at(x, y, 1) + img.at(x, y, 2)) / 3.0;
-              v += e.pixel[static_cast<size_t>(y) * 32 + x] * (m * m + kErrorEpsilon);
-            }
-          return v / (256.0 * 256.0);
-        };
         const double ms = quadrantMean(is, qx, qy), ma = quadrantMean(ia, qx, qy);
-        const double sd = std::sqrt(quadrantVar(es, is) + quadrantVar(ea, ia));
-        INFO(file, " quadrant ", qx, ",", qy, ": specialised ", ms, ", all features ", ma, ", sd ", sd);
+        INFO(file, " quadrant ", qx, ",", qy, ": specialised ", ms, ", all features ", ma);
         MESSAGE(std::string(file) << " quadrant " << qx << "," << qy << ": specialised " << ms << ", all features " << ma
-                     << ", sd of the difference " << sd << " (" << 100.0 * sd / ms << " %)");
-        CHECK(std::abs(ma - ms) <= 4.0 * sd);
+                                  << ", relative difference " << (ma - ms) / ms);
+        CHECK(std::abs(ma - ms) <= kMaxMeanDiff * ms);
       }
   }
 }

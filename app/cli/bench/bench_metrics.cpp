@@ -231,7 +231,7 @@ std::map<std::string, BenchSceneInfo> parseBenchScenes(const std::string& jsonTe
 std::string benchCsvHeader() {
   return "scene,integrator,dispersion,width,height,checkpoint,seconds,spp,samples_per_s,rays_per_s,primary_rays,"
          "secondary_rays,shadow_rays,non_finite,relmse,relmse_caustic,reference_noise,reference_noise_caustic,"
-         "gl_renderer";
+         "gl_renderer,cpu_seconds";
 }
 
 std::string benchCsvRow(const BenchRow& r) {
@@ -241,7 +241,7 @@ std::string benchCsvRow(const BenchRow& r) {
     << formatNumber(r.samplesPerSecond) << ',' << formatNumber(r.raysPerSecond) << ',' << r.primaryRays << ','
     << r.secondaryRays << ',' << r.shadowRays << ',' << r.nonFinite << ',' << formatNumber(r.relMse) << ','
     << formatNumber(r.relMseCaustic) << ',' << formatNumber(r.referenceNoise) << ','
-    << formatNumber(r.referenceNoiseCaustic) << ',' << csvField(r.glRenderer);
+    << formatNumber(r.referenceNoiseCaustic) << ',' << csvField(r.glRenderer) << ',' << formatNumber(r.cpuSeconds);
   return o.str();
 }
 

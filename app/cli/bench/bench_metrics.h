@@ -106,6 +106,8 @@ struct BenchRow {
   int width = 0, height = 0;
   int checkpoint = 0;             // index within the run, from 0
   double seconds = 0.0;           // render time so far (excludes checkpoint read-backs), seconds
+  double cpuSeconds = 0.0;        // the process's CPU time (every thread, llvmpipe's too) over the same spans:
+                                  // steadier than `seconds` on a machine whose load moves
   int spp = 0;                    // samples per pixel so far
   double samplesPerSecond = 0.0;  // camera paths per second
   double raysPerSecond = 0.0;     // primary + secondary + shadow rays per second (GPU counters)

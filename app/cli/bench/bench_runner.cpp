@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -187,6 +188,7 @@ class BenchRunner {
     const std::vector<double> schedule = checkpointSchedule(kFirstCheckpoint, setup_.maxSeconds, kCheckpointsPerOctave);
     const double pixels = double(s.width) * s.height;
     double elapsed = 0.0;  // seconds of rendering so far
+    double cpu = 0.0;      // process CPU seconds over the same spans
     size_t next = 0;       // the next checkpoint in `schedule`
     std::optional<AdaptiveSampler> sampler;
     if (adaptive) sampler.emplace(0.0, true);
@@ -197,12 +199,14 @@ class BenchRunner {
       // then an underestimate of the next pass's, which only makes batches shorter.
       if (sampler) n = std::max(1, std::min(n, nextCheck - renderer.samplesPerPixel()));
       auto t0 = Clock::now();
+      const std::clock_t c0 = std::clock();
       renderer.renderPass(n);
       if (sampler && renderer.samplesPerPixel() >= nextCheck) {
         sampler->check(renderer);
         nextCheck = sampler->checkAtOrAfter(renderer.samplesPerPixel() + 1);
       }
       elapsed += secondsSince(t0);
+      cpu += double(std::clock() - c0) / CLOCKS_PER_SEC;
       if (elapsed < schedule[next]) continue;
       while (next < schedule.size() && schedule[next] <= elapsed) ++next;
 
@@ -217,6 +221,7 @@ class BenchRunner {
       row.height = s.height;
       row.checkpoint = static_cast<int>(out.rows.size());
       row.seconds = elapsed;
+      row.cpuSeconds = cpu;
       row.spp = renderer.samplesPerPixel();
       // Adaptive runs sample some pixels only: count the paths traced (GPU counter) instead.
       row.samplesPerSecond = adaptive ? double(st.primaryRays) / elapsed : row.spp * pixels / elapsed;

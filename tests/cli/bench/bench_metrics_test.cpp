@@ -253,6 +253,7 @@ TEST_CASE("CSV rows have one field per header column, quoted where needed") {
   r.width = 256;
   r.height = 256;
   r.seconds = 1.5;
+  r.cpuSeconds = 2.75;
   r.spp = 12;
   r.relMse = 0.0123;
   r.relMseCaustic = std::nan("");
@@ -269,6 +270,7 @@ TEST_CASE("CSV rows have one field per header column, quoted where needed") {
   CHECK(field("gl_renderer") == r.glRenderer);
   CHECK(std::stod(field("relmse")) == doctest::Approx(0.0123));
   CHECK(std::stod(field("seconds")) == doctest::Approx(1.5));
+  CHECK(std::stod(field("cpu_seconds")) == doctest::Approx(2.75));
   CHECK(field("spp") == "12");
   CHECK(field("relmse_caustic") == "nan");
 
