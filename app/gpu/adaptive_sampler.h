@@ -12,7 +12,7 @@ namespace caustica {
 constexpr int kMinAdaptiveSpp = 16;  // no tile stops before every pixel has this many samples
 constexpr int kTileDilation = 1;     // a tile with over 4x the mean gain keeps its 8 neighbours live
 constexpr int kMaxSppRatio = 8;      // no tile falls behind the most sampled one by more than this factor
-constexpr int kAdaptiveTile = 8;     // side of the tiles in pixels (1, 2, 4 or 8; docs/adaptive-sampling.md)
+constexpr int kAdaptiveTile = 4;     // side of the tiles in pixels (1, 2, 4 or 8): 4 pays best (docs/benchmarks.md)
 
 // kAdaptiveTile, or the environment variable CAUSTICA_ADAPTIVE_TILE (1, 2, 4 or 8) where set: a knob
 // to measure other tile sizes with (docs/benchmarks.md, "Adaptive sampling"). Throws Error otherwise.

@@ -243,7 +243,7 @@ TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
   Renderer uniform(library(), scene, camera, rs);
   while (uniform.samplesPerPixel() < 3072) uniform.renderPass(64);
   const ErrorEstimate eu = uniform.errorEstimate();
-  for (int side : {8, 4}) {
+  for (int side : {8, 4, 2}) {
     INFO("adaptive tiles of " << side << "x" << side);
     rs.seed = 6;
     Renderer adaptive(library(), scene, camera, rs);
