@@ -191,7 +191,7 @@ void runOnThreads(unsigned threads, const Fn& fn) {
 // mode): the builder's big arrays are written once, and first-touch faults on 4 KiB pages cost as much
 // as the writing. Elsewhere, or when refused, a no-op.
 void adviseHugePages(void* p, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(BVH_NO_HUGE)
   constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
   const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
   const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
