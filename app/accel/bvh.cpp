@@ -1,4 +1,4 @@
-// bvh.cpp — binned-SAH BVH builder (a binary tree, packed into 64-byte gpu::BvhNode) and the C++ twins of the
+// bvh.cpp — binned-SAH BVH builder (writes 64-byte gpu::BvhNode directly, on threads) and the C++ twins of the
 // GLSL ray–triangle test (intersect.glsl) and stack traversal (traverse.glsl). All positions and
 // distances are in world space; t is measured in units of |ray.dir|.
 #include "accel/bvh.h"
@@ -111,8 +111,8 @@ struct Split {
   bool found() const { return axis >= 0 && std::isfinite(cost); }
 };
 
-// A node still to be built: its slot in the node array, its range of prims, its level, the bounds
-// of its prims and the bounds of their centroids.
+// A node still to be built (an inner node): its slot in the node array being written, its range of
+// prims, its level (root = 1), the bounds of its prims and the bounds of their centroids.
 struct WorkItem {
   std::uint32_t node;
   std::uint32_t first;
