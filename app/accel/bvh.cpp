@@ -13,9 +13,6 @@
 #include <thread>
 #include <cmath>
 #include <string>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 #if defined(__SSE__)
 #include <xmmintrin.h>
 #endif
@@ -185,21 +182,6 @@ void runOnThreads(unsigned threads, const Fn& fn) {
   guarded(0);
   for (std::thread& th : pool) th.join();
   if (failure) std::rethrow_exception(failure);
-}
-
-// Asks Linux to back [p, p + bytes) with 2 MiB pages where it can (transparent huge pages in "madvise"
-// mode): the builder's big arrays are written once, and first-touch faults on 4 KiB pages cost as much
-// as the writing. Elsewhere, or when refused, a no-op.
-void adviseHugePages(void* p, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(BVH_NO_HUGE)
-  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
-  const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
-  if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
-#else
-  (void)p;
-  (void)bytes;
-#endif
 }
 
 // Settings and shared inputs of one build. Every subtree owns a disjoint range of `prims`.
@@ -529,7 +511,6 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
   std::unique_ptr<Prim, FreeDeleter> primStore(static_cast<Prim*>(std::aligned_alloc(alignof(Prim), sizeof(Prim) * std::size_t(n))));
   if (!primStore) throw std::bad_alloc();
   Prim* const prims = primStore.get();
-  adviseHugePages(prims, sizeof(Prim) * std::size_t(n));
   std::vector<Box> partBox(threads), partCbox(threads);
   runOnThreads(threads, [&](unsigned t) {
     const std::uint32_t lo = std::uint32_t(std::uint64_t(n) * t / threads), hi = std::uint32_t(std::uint64_t(n) * (t + 1) / threads);
@@ -574,7 +555,6 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     // One thread: the nodes go straight into place. n slots bound the inner nodes; reserving them
     // only reserves address space (pages are touched as nodes are written).
     bvh.nodes.reserve(n);
-    adviseHugePages(bvh.nodes.data(), bvh.nodes.capacity() * sizeof(gpu::BvhNode));
     bvh.nodes.emplace_back();
     BuildStats st;
     buildSubtree(ctx, root, bvh.nodes, st, nullptr, 0);
@@ -607,7 +587,6 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
         WorkItem item = deferred[k].item;
         item.node = 0;
         sub[k].reserve(item.count);  // address space only, as above
-        adviseHugePages(sub[k].data(), sub[k].capacity() * sizeof(gpu::BvhNode));
         sub[k].emplace_back();
         buildSubtree(subCtx, item, sub[k], stats[k], nullptr, 0);
       }
@@ -633,8 +612,6 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
     auto fixSub = [&](std::uint32_t ref, std::size_t k) { return (ref & gpu::kBvhLeafBit) ? ref : base[k] + ref - 1; };
     // The top nodes (and the subtrees' roots, in their slots) first, then the blocks on all threads,
     // each thread copying and freeing whole subtrees.
-    bvh.nodes.reserve(globalOf[top.size()]);
-    adviseHugePages(bvh.nodes.data(), bvh.nodes.capacity() * sizeof(gpu::BvhNode));
     bvh.nodes.resize(globalOf[top.size()]);
     for (std::uint32_t t = 0; t < top.size(); ++t) {
       gpu::BvhNode node;
@@ -677,8 +654,6 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
   if (bvh.depth >= CAUSTICA_BVH_STACK)
     throw Error("bvh.cpp: BVH depth " + std::to_string(bvh.depth) + " exceeds the traversal stack");
   bvh.sahCost = float(sah);
-  bvh.order.reserve(n);
-  adviseHugePages(bvh.order.data(), bvh.order.capacity() * sizeof(std::uint32_t));
   bvh.order.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
   return bvh;
