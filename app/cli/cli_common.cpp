@@ -154,7 +154,7 @@ std::vector<OptionSpec> sceneInputOptionSpecs() {
        "refuse scenes with more than N triangles (default " + std::to_string(defaults.maxTriangles) + ")"},
       {"--instances", "", "auto|on|off",
        "keep meshes placed several times once on the GPU (two-level BVH): on, off (flatten them), or auto "
-       "(default): on when the placed triangles exceed --max-triangles or twice the stored ones"},
+       "(default): on when the placed triangles exceed --max-triangles or 4x the stored ones"},
   };
 }
 

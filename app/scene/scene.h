@@ -163,7 +163,7 @@ struct LoadOptions {
   // than autoInstanceFactor x the stored meshes' triangles. Otherwise the scene loads flattened, exactly
   // as without keepInstances (`--instances auto`, docs/big-scenes.md).
   bool autoInstances = false;
-  double autoInstanceFactor = 2.0;
+  double autoInstanceFactor = 4.0;  // instanced traversal costs ~1.4x flattened (docs/big-scenes.md)
 };
 
 // Bakes an instanced scene (Scene::instances not empty) into world-space triangles, exactly as the
