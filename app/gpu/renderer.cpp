@@ -79,7 +79,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   };
   auto t0 = std::chrono::steady_clock::now();
   const bool instanced = !scene.instances.empty();
-  if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/big-scenes.md "Instancing")
+  if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
     InstancedBvh ib = buildInstancedBvh(scene);
     bvhSeconds_ = load_.bvh = since(t0);
     bvh_.depth = ib.depth;

@@ -1,5 +1,5 @@
 // instances.cpp — flattenInstances: an instanced scene (LoadOptions::keepInstances) baked into the
-// world-space triangles the loader makes without it (docs/instancing-status.md).
+// world-space triangles the loader makes without it (docs/instancing.md).
 #include <cmath>
 #include <utility>
 #include <vector>

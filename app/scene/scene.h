@@ -96,7 +96,7 @@ struct Bounds {
   bool empty() const { return min.x > max.x; }
 };
 
-// Instancing (docs/instancing-status.md). A mesh stored once, in its own (object) space:
+// Instancing (docs/instancing.md). A mesh stored once, in its own (object) space:
 // Scene::triangles[firstTriangle, firstTriangle + triangleCount), in the file's winding.
 struct MeshRange {
   std::uint32_t firstTriangle = 0;
@@ -161,9 +161,9 @@ struct LoadOptions {
   // With keepInstances: keep them only where that pays, decided from the accessors' declared counts
   // before anything is decoded: when all instances together declare more than maxTriangles or more
   // than autoInstanceFactor x the stored meshes' triangles. Otherwise the scene loads flattened, exactly
-  // as without keepInstances (`--instances auto`, docs/big-scenes.md).
+  // as without keepInstances (`--instances auto`, docs/instancing.md).
   bool autoInstances = false;
-  double autoInstanceFactor = 4.0;  // instanced traversal costs ~1.4x flattened (docs/big-scenes.md)
+  double autoInstanceFactor = 4.0;  // instanced traversal costs ~1.4x flattened (docs/instancing.md)
 };
 
 // Bakes an instanced scene (Scene::instances not empty) into world-space triangles, exactly as the

@@ -1,6 +1,6 @@
 // traverse_instanced.glsl — two-level (instanced) traversal: twin of traverse<>() in app/accel/tlas.cpp;
 // keep the two in step. Include traverse.glsl first (which includes this file under CAUSTICA_INSTANCED:
-// traceClosest/traceOccluded then call traceInstanced; docs/big-scenes.md "Instancing"); tested against
+// traceClosest/traceOccluded then call traceInstanced; docs/instancing.md); tested against
 // the C++ twin by tests/gpu/traverse_gpu_test.cpp.
 //
 // Layout (InstancedBvh, gpu_layout.h InstanceRecord): bvhNodeTexels holds the top-level nodes (root 0),

@@ -96,7 +96,7 @@ CAUSTICA_CONST uint kBvhFirstMask = 0x07ffffffu;  // first triangle of a leaf: <
 CAUSTICA_CONST uint kBvhMaxLeafSize = 15u;         // 4 bits of count
 CAUSTICA_CONST uint kBvhEmptyRef = 0x80000000u;    // a leaf of no triangles
 
-// Instancing (docs/big-scenes.md): one record per instance, in
+// Instancing (docs/instancing.md): one record per instance, in
 // top-level leaf order, 64 bytes = 4 RGBA32 texels, meant to follow the BVH nodes in their buffer
 // texture. The top-level BVH's leaves are single instances (count 1, first = record index); a
 // bottom-level BVH's nodes and triangles are rebased into the shared node and TriGeom arrays.

@@ -1,4 +1,4 @@
-// instancing_test.cpp — instanced rendering (docs/big-scenes.md "Instancing"): a scene kept as meshes
+// instancing_test.cpp — instanced rendering (docs/instancing.md): a scene kept as meshes
 // and instances (two-level BVH, world-space shading from object space, instanced emitters in the light
 // tree) renders as its flattened copy does, in the path tracer (naive and mis) and in Whitted.
 #include <doctest/doctest.h>
