@@ -276,23 +276,32 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   GpuScene g;
   g.features = sceneFeatures(scene);
   g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
-  // Which meshes hold emitters or specular (caster) triangles; the emissive ones are numbered within
-  // their mesh (TriGeom.v1.w = that number + 1, the light-leaf table's order).
-  std::vector<bool> emissiveMesh(scene.meshes.size(), false), specularMesh(scene.meshes.size(), false);
+  // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
+  // the light-leaf table).
   std::vector<std::uint32_t> emissiveIndex(scene.triangles.size(), gpu::kInvalidIndex);
   std::vector<std::uint32_t> meshEmitters(scene.meshes.size(), 0);
   for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const MeshRange& r = scene.meshes[mi];
-    for (std::uint32_t i = r.firstTriangle; i < r.firstTriangle + r.triangleCount; ++i) {
-      const Material& m = scene.materials[scene.triangles[i].material];
-      if (m.isEmissive()) emissiveIndex[i] = meshEmitters[mi]++;
-      emissiveMesh[mi] = emissiveMesh[mi] || m.isEmissive();
-      specularMesh[mi] = specularMesh[mi] || m.metallic > 0.0f || m.transmission > 0.0f;
-    }
+    for (std::uint32_t i = r.firstTriangle; i < r.firstTriangle + r.triangleCount; ++i)
+      if (scene.materials[scene.triangles[i].material].isEmissive()) emissiveIndex[i] = meshEmitters[mi]++;
   }
-  g.casters = findCausticCasters(flattenedSubset(scene, specularMesh), CAUSTICA_MAX_CASTERS);
+  // The emissive and specular (caster) triangles of every instance are flattened on the host
+  // (transiently), bounded so that many placed emitters or glass objects cannot exhaust the host.
+  // Casters only speed up caustics: skipped beyond the bound.
+  std::vector<bool> emissive(scene.materials.size()), specular(scene.materials.size());
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    emissive[m] = scene.materials[m].isEmissive();
+    specular[m] = scene.materials[m].metallic > 0.0f || scene.materials[m].transmission > 0.0f;
+  }
+  constexpr std::uint64_t kMaxFlattened = 1u << 22;
+  if (placedTriangles(scene, specular) <= kMaxFlattened)
+    g.casters = findCausticCasters(flattenedSubset(scene, specular), CAUSTICA_MAX_CASTERS);
+  if (placedTriangles(scene, emissive) > kMaxFlattened)
+    throw Error(scene.path + ": the instances place " + std::to_string(placedTriangles(scene, emissive)) +
+                " emissive triangles; the light tree takes at most " + std::to_string(kMaxFlattened) +
+                " of an instanced scene (load it with --instances off)");
   std::vector<InstancedTriangle> source;
-  const Scene lights = flattenedSubset(scene, emissiveMesh, &source);
+  const Scene lights = flattenedSubset(scene, emissive, &source);
   g.emitterSphere = emitterBoundingSphere(lights);
   packEnvironment(scene, g);
   packMaterialsAndTextures(scene, g);

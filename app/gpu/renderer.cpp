@@ -118,10 +118,8 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
   uploadCasters();
   if (instanced) {  // the point lights of Whitted and raster: from world-space copies of the emissive meshes
-    std::vector<bool> emissive(scene.meshes.size(), false);
-    for (std::size_t m = 0; m < scene.meshes.size(); ++m)
-      for (std::uint32_t i = 0; i < scene.meshes[m].triangleCount && !emissive[m]; ++i)
-        emissive[m] = scene.materials[scene.triangles[scene.meshes[m].firstTriangle + i].material].isEmissive();
+    std::vector<bool> emissive(scene.materials.size());
+    for (std::size_t m = 0; m < scene.materials.size(); ++m) emissive[m] = scene.materials[m].isEmissive();
     lightGroups_ = groupEmitters(flattenedSubset(scene, emissive), CAUSTICA_MAX_POINT_LIGHTS);
   } else {
     lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);

@@ -11,16 +11,18 @@
 namespace caustica {
 
 namespace {
-// Appends instance `in`'s world-space triangles (zero-area ones dropped) to `out`, and to `source` (when
-// given) the Scene::triangles index each came from.
+// Appends instance `in`'s world-space triangles (zero-area ones dropped; with `materialWanted`, only
+// those of the wanted materials) to `out`, and to `source` (when given) the Scene::triangles index each
+// came from.
 void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangle>& out,
-                     std::vector<std::uint32_t>* source) {
+                     std::vector<std::uint32_t>* source, const std::vector<bool>* materialWanted = nullptr) {
   const MeshRange& m = scene.meshes[in.mesh];
   const glm::dmat3 m3(in.world);
   const glm::dmat3 normal = glm::transpose(glm::inverse(m3));
   const bool flip = glm::determinant(m3) < 0.0;  // as the loader: restore counter-clockwise fronts
   for (std::uint32_t i = m.firstTriangle; i < m.firstTriangle + m.triangleCount; ++i) {
     const Triangle& src = scene.triangles[i];
+    if (materialWanted && (src.material >= materialWanted->size() || !(*materialWanted)[src.material])) continue;
     Triangle t;
     t.material = src.material;
     for (int k = 0; k < 3; ++k) {
@@ -54,7 +56,24 @@ void flattenInstances(Scene& scene) {
   scene.instances.clear();
 }
 
-Scene flattenedSubset(const Scene& scene, const std::vector<bool>& meshWanted, std::vector<InstancedTriangle>* source) {
+std::vector<std::uint64_t> wantedPerMesh(const Scene& scene, const std::vector<bool>& materialWanted) {
+  std::vector<std::uint64_t> n(scene.meshes.size(), 0);
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+    for (std::uint32_t i = 0; i < scene.meshes[m].triangleCount; ++i) {
+      const std::uint32_t mat = scene.triangles[scene.meshes[m].firstTriangle + i].material;
+      if (mat < materialWanted.size() && materialWanted[mat]) ++n[m];
+    }
+  return n;
+}
+
+std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& materialWanted) {
+  const std::vector<std::uint64_t> perMesh = wantedPerMesh(scene, materialWanted);
+  std::uint64_t n = 0;
+  for (const Instance& in : scene.instances) n += perMesh[in.mesh];
+  return n;
+}
+
+Scene flattenedSubset(const Scene& scene, const std::vector<bool>& materialWanted, std::vector<InstancedTriangle>* source) {
   Scene out;
   out.path = scene.path;
   out.materials = scene.materials;
@@ -62,12 +81,13 @@ Scene flattenedSubset(const Scene& scene, const std::vector<bool>& meshWanted, s
   out.spotEmitters = scene.spotEmitters;
   out.bounds = scene.bounds;
   out.origin = scene.origin;
+  const std::vector<std::uint64_t> perMesh = wantedPerMesh(scene, materialWanted);
   std::vector<std::uint32_t> from;
   for (std::uint32_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& in = scene.instances[i];
-    if (in.mesh >= meshWanted.size() || !meshWanted[in.mesh]) continue;
+    if (perMesh[in.mesh] == 0) continue;
     from.clear();
-    flattenInstance(scene, in, out.triangles, &from);
+    flattenInstance(scene, in, out.triangles, &from, &materialWanted);
     if (source)
       for (std::uint32_t t : from) source->push_back({i, t});
   }

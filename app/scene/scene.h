@@ -176,13 +176,15 @@ struct InstancedTriangle {
   std::uint32_t instance = 0;  // Scene::instances index
   std::uint32_t triangle = 0;  // Scene::triangles index (object space)
 };
-// The world-space triangles (as flattenInstances makes them) of the instances whose mesh has
-// meshWanted[mesh], in a scene with the materials, lights, bounds and origin but no textures: what the
-// host-side passes over emitters and specular objects (light groups, caustic casters, the emitter
-// sphere, the light tree) need from an instanced scene without flattening all of it. `source`, when
-// given, receives one InstancedTriangle per triangle.
-Scene flattenedSubset(const Scene& scene, const std::vector<bool>& meshWanted,
+// The world-space triangles (as flattenInstances makes them) of every instance whose material has
+// materialWanted[material], in a scene with the materials, lights, bounds and origin but no textures:
+// what the host-side passes over emitters and specular objects (light groups, caustic casters, the
+// emitter sphere, the light tree) need from an instanced scene without flattening all of it. `source`,
+// when given, receives one InstancedTriangle per triangle.
+Scene flattenedSubset(const Scene& scene, const std::vector<bool>& materialWanted,
                       std::vector<InstancedTriangle>* source = nullptr);
+// How many triangles flattenedSubset(scene, materialWanted) would make (zero-area ones included).
+std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& materialWanted);
 
 // Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const LoadOptions& options);
