@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "accel/bvh_wide.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
 
@@ -88,6 +89,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   bvh_.nodes.clear();
   gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
   gpuScene_.nodes = std::move(nodes);
+  std::vector<gpu::BvhWideNode> wideNodes = packBvhWideNodes(bvh_.binary).nodes;  // what traverse.glsl reads
   std::vector<BvhBinaryNode>().swap(bvh_.binary);  // the builder's tree: the GPU nodes were made from it
   load_.pack = since(t0);
 
@@ -100,10 +102,12 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   }
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
+  gpuBytes_.nodes += wideNodes.size() * sizeof(gpu::BvhWideNode);
   t0 = std::chrono::steady_clock::now();
   uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
   bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
-                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path);
+                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path, wideNodes);
+  std::vector<gpu::BvhWideNode>().swap(wideNodes);
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
