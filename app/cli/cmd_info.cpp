@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "cli/environment_options.h"
 #include "accel/bvh.h"
+#include "accel/bvh_wide.h"
 #include "util/error.h"
 #include "accel/gpu_scene.h"
 #include "shading/microfacet.h"
@@ -96,7 +97,12 @@ int cmdInfo(const std::vector<std::string>& args) {
               s.cameras.size());
   std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
               bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
-  std::printf("memory:     %s; %s\n", gpuBytesSummary(gpuSceneBytes(g), s.triangles.size()).c_str(),
+  const BvhWide wide = packBvhWideNodes(bvh.binary);  // what the traversal reads
+  std::printf("bvh 4-wide: %zu nodes (%zu KiB), depth %d, stack need %d\n", wide.nodes.size(),
+              wide.nodes.size() * sizeof(gpu::BvhWideNode) / 1024, wide.depth, wide.stackNeed);
+  GpuSceneBytes bytes = gpuSceneBytes(g);  // as the renderer uploads: the 4-wide nodes and the binary root
+  bytes.nodes = wide.nodes.size() * sizeof(gpu::BvhWideNode) + sizeof(gpu::BvhNode);
+  std::printf("memory:     %s; %s\n", gpuBytesSummary(bytes, s.triangles.size()).c_str(),
               hostPeakSummary(s.triangles.size()).c_str());
   std::printf("load:       parse %.2f s, BVH %.2f s, pack %.2f s (upload and first sample: render's load line)\n",
               parseSeconds, buildSeconds, packSeconds);
