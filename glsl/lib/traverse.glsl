@@ -14,8 +14,8 @@
 //     index; else a leaf over triGeom[first .. first + count - 1] (first = ref & kBvhFirstMask,
 //     count = ref >> kBvhCountShift & 15; count 0: an empty slot). nodes[0] is the root.
 //   TriGeom i = texels 3i..3i+2 of triGeomTexels: v0.xyz, v1.xyz, v2.xyz as float bits, world space.
-//   Tree depth (root = 1) is < CAUSTICA_BVH_STACK and near-first traversal pushes at most one ref per
-//   level, so the stack cannot overflow; the sp check only guards memory against a malformed tree.
+//   Binary tree depth (root = 1) is < CAUSTICA_BVH_STACK and the binary near-first traversal
+//   (traverse_instanced.glsl) pushes at most one ref per level; the sp checks only guard memory.
 //
 // Loop shape (for SIMD drivers such as llvmpipe, which run 8 invocations in lock-step and execute both
 // sides of every branch): an inner loop descends through inner nodes until every lane holds a leaf,
