@@ -16,15 +16,15 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // Entry distance of a child the ray misses: above every hit's (tnear <= tmax * kBoxPad <= 3e38 * pad).
 constexpr float kMissT = 3.4e38f;
 
-float surfaceArea(const BvhBinaryNode& n) {
-  const glm::vec3 e = n.bmax - n.bmin;
-  return e.x * e.y + e.y * e.z + e.z * e.x;
-}
+// One child of a node under construction: its world-space box and ref (gpu_layout.h, BvhNode).
+struct Slot {
+  glm::vec3 lo, hi;
+  std::uint32_t ref;
+};
 
-std::uint32_t leafRef(const BvhBinaryNode& b) {
-  if (b.leftFirst > gpu::kBvhFirstMask || b.triCount > gpu::kBvhMaxLeafSize)
-    throw Error("bvh_wide.cpp: leaf out of the packed range (internal error)");
-  return gpu::kBvhLeafBit | b.triCount << gpu::kBvhCountShift | b.leftFirst;
+float surfaceArea(const Slot& c) {
+  const glm::vec3 e = c.hi - c.lo;
+  return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
 void setSlot(gpu::BvhWideNode& n, int k, const glm::vec3& lo, const glm::vec3& hi, std::uint32_t ref) {
@@ -43,68 +43,74 @@ gpu::BvhWideNode emptyWideNode() {
   return n;
 }
 
+bool isInner(std::uint32_t ref) { return (ref & gpu::kBvhLeafBit) == 0; }
+
 }  // namespace
 
-BvhWide packBvhWideNodes(const std::vector<BvhBinaryNode>& binary) {
+BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
   BvhWide out;
   out.nodes.push_back(emptyWideNode());
   out.depth = 1;
   if (binary.empty()) return out;
-  const BvhBinaryNode& root = binary[0];
-  if (root.triCount > 0 || !(root.bmin.x <= root.bmax.x)) {  // one leaf, or an empty tree
-    if (root.triCount > 0) setSlot(out.nodes[0], 0, root.bmin, root.bmax, leafRef(root));
-    return out;
-  }
   struct Work {
-    std::uint32_t binaryNode;  // binary inner node this wide node collapses
+    std::uint32_t binaryNode;  // binary node whose children this wide node collapses
     std::uint32_t wideIndex;   // where it goes in out.nodes
     int depth;                 // wide level, root = 1
     int stackBefore;           // stack entries the traversal may hold on arriving here
   };
   std::vector<Work> work{{0, 0, 1, 0}};
-  out.nodes.reserve(binary.size() / 4 + 1);
+  out.nodes.reserve(binary.size() / 2 + 1);
   while (!work.empty()) {
     const Work w = work.back();
     work.pop_back();
-    // Open the inner child of largest surface area until there are four children or only leaves.
-    std::uint32_t kids[4] = {binary[w.binaryNode].leftFirst, binary[w.binaryNode].leftFirst + 1, 0, 0};
-    int count = 2;
+    // The binary node's non-empty children; then open the inner child of largest surface area until
+    // there are four children or only leaves (left-to-right order kept).
+    Slot kids[4];
+    int count = 0;
+    auto addChildren = [&](std::uint32_t node, int at) {
+      if (node >= binary.size()) throw Error("bvh_wide.cpp: node ref out of range (internal error)");
+      const gpu::BvhNode& b = binary[node];
+      const Slot two[2] = {{b.lmin, b.lmax, b.left}, {b.rmin, b.rmax, b.right}};
+      for (const Slot& c : two) {
+        if (c.ref == gpu::kBvhEmptyRef) continue;
+        for (int k = count; k > at; --k) kids[k] = kids[k - 1];
+        kids[at++] = c;
+        ++count;
+      }
+    };
+    addChildren(w.binaryNode, 0);
     while (count < 4) {
       int best = -1;
       float bestArea = -1.0f;
-      for (int k = 0; k < count; ++k) {
-        const BvhBinaryNode& c = binary[kids[k]];
-        if (c.triCount == 0 && surfaceArea(c) > bestArea) {
-          bestArea = surfaceArea(c);
+      for (int k = 0; k < count; ++k)
+        if (isInner(kids[k].ref) && surfaceArea(kids[k]) > bestArea) {
+          bestArea = surfaceArea(kids[k]);
           best = k;
         }
-      }
       if (best < 0) break;
-      const std::uint32_t opened = kids[best];
-      for (int k = count; k > best + 1; --k) kids[k] = kids[k - 1];  // keep left-to-right order
-      kids[best] = binary[opened].leftFirst;
-      kids[best + 1] = binary[opened].leftFirst + 1;
-      ++count;
+      const std::uint32_t opened = kids[best].ref;
+      for (int k = best; k + 1 < count; ++k) kids[k] = kids[k + 1];  // remove it...
+      --count;
+      addChildren(opened, best);  // ...and put its two children in its place
     }
-    // The traversal writes three stack slots from sp on at every inner node, then keeps count - 1.
+    // The traversal writes up to three stack slots from sp on at every inner node, then keeps count - 1.
     out.stackNeed = std::max(out.stackNeed, w.stackBefore + 3);
     out.depth = std::max(out.depth, w.depth);
     gpu::BvhWideNode n = emptyWideNode();
-    // Children pushed in reverse so that the first child's subtree is packed next (depth-first).
-    std::uint32_t refs[4];
+    int innerKids = 0;
     for (int k = 0; k < count; ++k) {
-      const BvhBinaryNode& c = binary[kids[k]];
-      if (c.triCount > 0) {
-        refs[k] = leafRef(c);
-      } else {
-        refs[k] = static_cast<std::uint32_t>(out.nodes.size());
+      std::uint32_t ref = kids[k].ref;
+      if (isInner(ref)) {  // a binary inner node becomes a wide node, packed when its work item is popped
+        work.push_back({ref, static_cast<std::uint32_t>(out.nodes.size()), w.depth + 1, w.stackBefore + count - 1});
+        ref = static_cast<std::uint32_t>(out.nodes.size());
         out.nodes.push_back(emptyWideNode());
+        ++innerKids;
       }
-      setSlot(n, k, c.bmin, c.bmax, refs[k]);
+      setSlot(n, k, kids[k].lo, kids[k].hi, ref);
     }
     out.nodes[w.wideIndex] = n;
-    for (int k = count - 1; k >= 0; --k)
-      if ((refs[k] & gpu::kBvhLeafBit) == 0) work.push_back({kids[k], refs[k], w.depth + 1, w.stackBefore + count - 1});
+    // Depth-first: the first child's subtree next (its work item on top).
+    std::reverse(work.end() - innerKids, work.end());
   }
   if (out.stackNeed > CAUSTICA_BVH_WIDE_STACK)
     throw Error("bvh_wide.cpp: the 4-wide traversal would need " + std::to_string(out.stackNeed) +

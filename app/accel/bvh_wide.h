@@ -16,13 +16,13 @@ struct BvhWide {
   int stackNeed = 0;    // most stack entries the traversal can hold (<= CAUSTICA_BVH_WIDE_STACK - 2, checked)
 };
 
-// Collapses the binary tree (BvhBinaryNode, binary[0] the root, children adjacent) into 4-wide nodes:
-// each wide node starts from a binary inner node's two children and repeatedly opens the inner child of
-// largest surface area until it has four children or only leaves. Leaves stay as they are (same
-// triangles, same TriGeom order). A one-leaf tree gets a root with that leaf in slot 0, an empty tree a
-// root of empty slots. Throws caustica::Error if the traversal stack could overflow (never for a tree
-// that buildBvh accepts).
-BvhWide packBvhWideNodes(const std::vector<BvhBinaryNode>& binary);
+// Collapses the binary tree (Bvh::nodes: gpu::BvhNode, both children's boxes and refs per inner node,
+// nodes[0] the root) into 4-wide nodes: each wide node starts from a binary node's two children and
+// repeatedly opens the inner child of largest surface area until it has four children or only leaves.
+// Leaves stay as they are (same refs, same TriGeom order); empty slots are dropped, so a one-leaf tree
+// gets a root with that leaf in slot 0 and an empty tree a root of empty slots. Throws caustica::Error
+// if the traversal stack could overflow (never for a tree that buildBvh accepts).
+BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary);
 
 // Closest hit with t in (0, tmax) through the 4-wide nodes. Twin of traceClosest() in traverse.glsl.
 Hit traceClosest(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriGeom>& tris,

@@ -97,7 +97,7 @@ int cmdInfo(const std::vector<std::string>& args) {
               s.cameras.size());
   std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
               bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
-  const BvhWide wide = packBvhWideNodes(bvh.binary);  // what the traversal reads
+  const BvhWide wide = packBvhWideNodes(bvh.nodes);  // what the traversal reads
   std::printf("bvh 4-wide: %zu nodes (%zu KiB), depth %d, stack need %d\n", wide.nodes.size(),
               wide.nodes.size() * sizeof(gpu::BvhWideNode) / 1024, wide.depth, wide.stackNeed);
   GpuSceneBytes bytes = gpuSceneBytes(g);  // as the renderer uploads: the 4-wide nodes and the binary root

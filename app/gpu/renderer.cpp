@@ -89,8 +89,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   bvh_.nodes.clear();
   gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
   gpuScene_.nodes = std::move(nodes);
-  std::vector<gpu::BvhWideNode> wideNodes = packBvhWideNodes(bvh_.binary).nodes;  // what traverse.glsl reads
-  std::vector<BvhBinaryNode>().swap(bvh_.binary);  // the builder's tree: the GPU nodes were made from it
+  std::vector<gpu::BvhWideNode> wideNodes = packBvhWideNodes(gpuScene_.nodes).nodes;  // what traverse.glsl reads
   load_.pack = since(t0);
 
   GpuScene& g = gpuScene_;

@@ -52,7 +52,7 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
   prog.use();
   BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test",
-                       packBvhWideNodes(bvh.binary).nodes);
+                       packBvhWideNodes(bvh.nodes).nodes);
   textures.bind();
   geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);
   rayBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 8);
@@ -96,7 +96,7 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
   std::vector<std::uint32_t> occ;
   traceOnGpu(bvh, geom, rays, hits, occ);
 
-  const std::vector<gpu::BvhWideNode> wide = packBvhWideNodes(bvh.binary).nodes;
+  const std::vector<gpu::BvhWideNode> wide = packBvhWideNodes(bvh.nodes).nodes;
   int mismatches = 0, hitCount = 0;
   for (int i = 0; i < rayCount; ++i) {
     Hit h = traceClosest(wide, geom, cpuRays[i], tmaxes[i]);
@@ -179,7 +179,7 @@ TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never e
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
   traceOnGpu(bvh, geom, rays, hits, occ);
-  const BvhWide wide = packBvhWideNodes(bvh.binary);
+  const BvhWide wide = packBvhWideNodes(bvh.nodes);
   int gpuEscapes = 0, cpuEscapes = 0, gpuOccMisses = 0;
   for (int k = 0; k < rayCount; ++k) {
     gpuEscapes += glm::floatBitsToUint(hits[k].w) == gpu::kInvalidIndex;
