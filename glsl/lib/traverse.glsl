@@ -1,7 +1,8 @@
 // traverse.glsl — closest-hit and any-hit BVH traversal over the 112-byte 4-wide BVH nodes and the
 // triangle positions, both read through buffer textures (bindings.glsl). Twin of traceClosest()/
 // traceOccluded() over gpu::BvhWideNode in app/accel/bvh_wide.cpp; keep the two in step. Also holds the
-// binary node visit (bvhVisitNode, twin of app/accel/bvh.cpp) that traverse_instanced.glsl uses.
+// binary node visit (bvhVisitNode, twin of app/accel/bvh.cpp) that traverse_instanced.glsl uses:
+// instanced scenes (CAUSTICA_INSTANCED) trace through the binary two-level BVH instead of the wide nodes.
 // Include bindings.glsl, spawn.glsl and intersect.glsl first.
 //
 // Packing relied on (glsl/shared/gpu_layout.h, built by buildBvh/packBvhWideNodes/packTriGeom):
@@ -29,6 +30,9 @@ struct Hit {
   float u;   // barycentric weight of v1
   float v;   // barycentric weight of v2
   uint tri;  // index into triGeom[] (leaf order), kInvalidIndex when nothing was hit
+#ifdef CAUSTICA_INSTANCED
+  uint inst; // the Scene::instances index of the hit (instanced scenes: tri is a stored, object-space triangle)
+#endif
 };
 
 // Relative widening of a box's exit distance (as in intersectAabb): a stacked subtree is skipped only
@@ -102,6 +106,28 @@ uint bvhVisitWide(uint index, vec3 org, vec3 invDir, float tmax, out uvec4 ref, 
   return e.x + e.y + e.z + e.w;
 }
 
+// The two-level traversal (traceInstanced) and the instances' world-space triangles (instances.glsl,
+// empty without CAUSTICA_INSTANCED). Included always: the shader library expands #include before the
+// preprocessor runs, and a file is expanded once.
+#include "traverse_instanced.glsl"
+#include "instances.glsl"
+
+#ifdef CAUSTICA_INSTANCED
+// Instanced scenes: both queries go through the two-level traversal.
+
+bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
+  uint inst;
+  bool found = traceInstanced(org, dir, tmax, CAUSTICA_INSTANCE_RECORD_BASE, false, hit, inst);
+  hit.inst = inst;
+  return found;
+}
+
+bool traceOccluded(vec3 org, vec3 dir, float tmax) {
+  Hit hit;
+  uint inst;
+  return traceInstanced(org, dir, tmax, CAUSTICA_INSTANCE_RECORD_BASE, true, hit, inst);
+}
+#else
 // Closest hit with 0 < t < tmax. On a miss returns false with hit.t = tmax and hit.tri = kInvalidIndex.
 bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   hit.t = tmax;
@@ -218,3 +244,4 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   }
   return false;
 }
+#endif  // CAUSTICA_INSTANCED
