@@ -78,11 +78,12 @@ bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const
 bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
                        float tmax, float& t, float& u, float& v);
 
-// Closest hit with t in (0, tmax). Twin of traceClosest() in traverse.glsl.
+// Closest hit with t in (0, tmax) over the binary nodes: the reference for the 4-wide twin (bvh_wide.h)
+// and the visiting order of bvhVisitNode() in traverse.glsl (used by traverse_instanced.glsl).
 Hit traceClosest(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriGeom>& tris,
                  const Ray& ray, float tmax = std::numeric_limits<float>::infinity());
 
-// Any hit with t in (0, tmax). Twin of traceOccluded() in traverse.glsl.
+// Any hit with t in (0, tmax) over the binary nodes (see traceClosest above).
 bool traceOccluded(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriGeom>& tris,
                    const Ray& ray, float tmax);
 

@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "cli/environment_options.h"
 #include "accel/bvh.h"
+#include "accel/bvh_wide.h"
 #include "util/error.h"
 #include "accel/gpu_scene.h"
 #include "accel/tlas.h"
@@ -102,14 +103,20 @@ int cmdInfo(const std::vector<std::string>& args) {
               s.cameras.empty() ? "automatic" : ("'" + c.name + "'").c_str(), vec(c.position).c_str(),
               vec(c.forward).c_str(), c.yfov * 57.29578f, c.aspect > 0 ? (", aspect " + std::to_string(c.aspect)).c_str() : "",
               s.cameras.size());
-  if (instanced)
+  GpuSceneBytes bytes = gpuSceneBytes(g);
+  if (instanced) {
     std::printf("bvh:        two-level, %zu top-level + %zu mesh nodes, %u instance records (%zu KiB with the records), "
                 "depth %d, built in %.1f ms\n", topNodes, allNodes - topNodes, g.instanceCount,
                 g.nodes.size() * sizeof(gpu::BvhNode) / 1024, ibvh.depth, buildSeconds * 1e3);
-  else
+  } else {
     std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
                 bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
-  std::printf("memory:     %s; %s\n", gpuBytesSummary(gpuSceneBytes(g), s.triangles.size()).c_str(),
+    const BvhWide wide = packBvhWideNodes(bvh.nodes);  // what the flat traversal reads
+    std::printf("bvh 4-wide: %zu nodes (%zu KiB), depth %d, stack need %d\n", wide.nodes.size(),
+                wide.nodes.size() * sizeof(gpu::BvhWideNode) / 1024, wide.depth, wide.stackNeed);
+    bytes.nodes = wide.nodes.size() * sizeof(gpu::BvhWideNode) + sizeof(gpu::BvhNode);  // as the renderer uploads
+  }
+  std::printf("memory:     %s; %s\n", gpuBytesSummary(bytes, s.triangles.size()).c_str(),
               hostPeakSummary(s.triangles.size()).c_str());
   std::printf("load:       parse %.2f s, BVH %.2f s, pack %.2f s (upload and first sample: render's load line)\n",
               parseSeconds, buildSeconds, packSeconds);

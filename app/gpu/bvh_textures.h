@@ -1,25 +1,31 @@
 // bvh_textures.h — the buffer textures through which the shaders' traversal reads the BVH nodes and
-// the triangle positions (glsl/lib/traverse.glsl): views of the nodes and TriGeom buffers, no copies.
+// the triangle positions (glsl/lib/traverse.glsl): views of the nodes and TriGeom buffers, no copies,
+// and the 4-wide nodes (gpu::BvhWideNode) in a buffer of their own, uploaded here.
 #pragma once
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "gpu/gl_objects.h"
+#include "shared/gpu_layout.h"
 
 namespace caustica {
 
 class BvhTextures {
  public:
   BvhTextures() = default;
-  // Views `nodes` (gpu::BvhNode[]) and `triGeom` (gpu::TriGeom[]) as RGBA32UI texels. Throws Error
-  // naming `what` (the scene's path) when either has more texels than GL_MAX_TEXTURE_BUFFER_SIZE.
+  // Views `nodes` (gpu::BvhNode[]) and `triGeom` (gpu::TriGeom[]) as RGBA32UI texels, and uploads
+  // `wide` (packBvhWideNodes' nodes, which traverse.glsl reads; empty: a root of empty slots, for
+  // callers that use only the binary nodes) into a buffer of its own. Throws Error naming `what` (the
+  // scene's path) when any has more texels than GL_MAX_TEXTURE_BUFFER_SIZE.
   BvhTextures(const GlBuffer& nodes, std::size_t nodeCount, const GlBuffer& triGeom, std::size_t triCount,
-              const std::string& what);
-  // Binds both on CAUSTICA_TEXUNIT_BVH_NODES and CAUSTICA_TEXUNIT_TRI_GEOM.
+              const std::string& what, const std::vector<gpu::BvhWideNode>& wide = {});
+  // Binds them on CAUSTICA_TEXUNIT_BVH_NODES, CAUSTICA_TEXUNIT_TRI_GEOM and CAUSTICA_TEXUNIT_BVH_WIDE.
   void bind() const;
 
  private:
-  GlBufferTexture nodes_, triGeom_;
+  GlBuffer wideBuffer_;  // the 4-wide nodes (declared before wide_, which views it)
+  GlBufferTexture nodes_, triGeom_, wide_;
 };
 
 }  // namespace caustica

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "accel/bvh_wide.h"
 #include "accel/tlas.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
@@ -79,6 +80,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   };
   auto t0 = std::chrono::steady_clock::now();
   const bool instanced = !scene.instances.empty();
+  std::vector<gpu::BvhWideNode> wideNodes;  // what traverse.glsl reads in flat scenes
   if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
     InstancedBvh ib = buildInstancedBvh(scene);
     bvhSeconds_ = load_.bvh = since(t0);
@@ -93,6 +95,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     bvh_.nodes.clear();
     gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
     gpuScene_.nodes = std::move(nodes);
+    wideNodes = packBvhWideNodes(gpuScene_.nodes).nodes;
   }
   load_.pack = since(t0);
 
@@ -103,12 +106,18 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     sceneBounds.grow(bvhLo);
     sceneBounds.grow(bvhHi);
   }
+  // Flat scenes trace through the 4-wide nodes only (traverse.glsl), so the binary node buffer keeps
+  // just the root there (~32 B per triangle less on the GPU). Instanced scenes trace the binary
+  // two-level BVH (nodes, then instance records) and get an empty wide tree.
+  if (!instanced) g.nodes.resize(std::min<std::size_t>(g.nodes.size(), 1));
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
+  gpuBytes_.nodes += wideNodes.size() * sizeof(gpu::BvhWideNode);
   t0 = std::chrono::steady_clock::now();
   uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
   bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
-                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path);
+                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path, wideNodes);
+  std::vector<gpu::BvhWideNode>().swap(wideNodes);
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);

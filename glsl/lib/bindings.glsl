@@ -6,6 +6,7 @@
 // (texelFetch is a vector gather on llvmpipe; an SSBO load there is a loop over the lanes).
 layout(binding = CAUSTICA_TEXUNIT_BVH_NODES) uniform usamplerBuffer bvhNodeTexels;  // 4 texels per BvhNode
 layout(binding = CAUSTICA_TEXUNIT_TRI_GEOM) uniform usamplerBuffer triGeomTexels;   // 3 texels per TriGeom
+layout(binding = CAUSTICA_TEXUNIT_BVH_WIDE) uniform usamplerBuffer bvhWideTexels;   // 7 texels per BvhWideNode
 layout(std430, binding = CAUSTICA_BINDING_TRISHADE) readonly buffer TriShadeBuffer { uint triShadeWords[]; };
 layout(std430, binding = CAUSTICA_BINDING_MATERIALS) readonly buffer MaterialBuffer { Material materials[]; };
 layout(std430, binding = CAUSTICA_BINDING_EMITTERS) readonly buffer EmitterBuffer { LightNode lightNodes[]; };

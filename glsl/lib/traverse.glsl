@@ -1,21 +1,29 @@
-// traverse.glsl — closest-hit and any-hit BVH traversal over the 64-byte BVH nodes and the triangle
-// positions, both read through buffer textures (bindings.glsl). Twin of traceClosest()/traceOccluded()
-// in app/accel/bvh.cpp; keep the two in step. Include bindings.glsl, spawn.glsl and intersect.glsl first.
+// traverse.glsl — closest-hit and any-hit BVH traversal over the 112-byte 4-wide BVH nodes and the
+// triangle positions, both read through buffer textures (bindings.glsl). Twin of traceClosest()/
+// traceOccluded() over gpu::BvhWideNode in app/accel/bvh_wide.cpp; keep the two in step. Also holds the
+// binary node visit (bvhVisitNode, twin of app/accel/bvh.cpp) that traverse_instanced.glsl uses:
+// instanced scenes (CAUSTICA_INSTANCED) trace through the binary two-level BVH instead of the wide nodes.
+// Include bindings.glsl, spawn.glsl and intersect.glsl first.
 //
-// Packing relied on (glsl/shared/gpu_layout.h, built by buildBvh/packTriGeom):
+// Packing relied on (glsl/shared/gpu_layout.h, built by buildBvh/packBvhWideNodes/packTriGeom):
+//   BvhWideNode i = texels 7i..7i+6 of bvhWideTexels: minX, maxX, minY, maxY, minZ, maxZ (component k =
+//     child k, float bits, world space), then the four child refs. A ref is a wide node's index (bit 31
+//     clear) or a leaf as in BvhNode; an unused slot is kBvhEmptyRef with a box at +inf, never entered.
+//     bvhWideTexels' node 0 is the root. Stack use is bounded by packBvhWideNodes (< CAUSTICA_BVH_WIDE_STACK).
 //   BvhNode i = texels 4i..4i+3 of bvhNodeTexels: (lmin, left ref), (lmax, 0), (rmin, right ref),
 //     (rmax, 0); boxes as float bits in world space. A ref with kBvhLeafBit clear is an inner node's
 //     index; else a leaf over triGeom[first .. first + count - 1] (first = ref & kBvhFirstMask,
 //     count = ref >> kBvhCountShift & 15; count 0: an empty slot). nodes[0] is the root.
 //   TriGeom i = texels 3i..3i+2 of triGeomTexels: v0.xyz, v1.xyz, v2.xyz as float bits, world space.
-//   Tree depth (root = 1) is < CAUSTICA_BVH_STACK and near-first traversal pushes at most one ref per
-//   level, so the stack cannot overflow; the sp check only guards memory against a malformed tree.
+//   Binary tree depth (root = 1) is < CAUSTICA_BVH_STACK and the binary near-first traversal
+//   (traverse_instanced.glsl) pushes at most one ref per level; the sp checks only guard memory.
 //
 // Loop shape (for SIMD drivers such as llvmpipe, which run 8 invocations in lock-step and execute both
 // sides of every branch): an inner loop descends through inner nodes until every lane holds a leaf,
-// then the lanes test their leaves' triangles together. The visiting order is plain near-first
-// depth-first, the same as the C++ twin's, so ties between equal t resolve the same way. A popped
-// subtree whose entry distance is beyond the closest hit so far is skipped.
+// then the lanes test their leaves' triangles together. At a wide node the entered children are sorted
+// by entry distance (a 5-exchange network): the nearest is visited next, the others stacked with their
+// entry distances, nearest on top — the same order as the C++ twin's, so ties between equal t resolve
+// the same way. A popped subtree whose entry distance is beyond the closest hit so far is skipped.
 
 struct Hit {
   float t;   // distance along dir (units of |dir|)
@@ -55,6 +63,49 @@ void bvhTriangle(uint i, out vec3 p0, out vec3 p1, out vec3 p2) {
   p2 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i + 2u)).xyz);
 }
 
+// Entry distance given to a child the ray misses: above any entered child's (<= tmax * kBvhBoxPad <= 3e38 * pad).
+const float kBvhMissT = 3.4e38;
+
+// Swaps (ta, ra) and (tb, rb) when tb is strictly nearer.
+void bvhSortPair(inout float ta, inout uint ra, inout float tb, inout uint rb) {
+  bool s = tb < ta;
+  float t0 = ta;
+  uint r0 = ra;
+  ta = s ? tb : ta;
+  tb = s ? t0 : tb;
+  ra = s ? rb : ra;
+  rb = s ? r0 : rb;
+}
+
+// Tests the four children of wide node `index` against the ray within tmax (intersectAabb on each
+// component). Returns how many it enters; ref/t = the children sorted by entry distance (units of
+// |dir|), entered ones first, missed ones after at kBvhMissT.
+uint bvhVisitWide(uint index, vec3 org, vec3 invDir, float tmax, out uvec4 ref, out vec4 t) {
+  int base = int(7u * index);
+  vec4 x0 = (uintBitsToFloat(texelFetch(bvhWideTexels, base)) - org.x) * invDir.x;
+  vec4 x1 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 1)) - org.x) * invDir.x;
+  vec4 y0 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 2)) - org.y) * invDir.y;
+  vec4 y1 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 3)) - org.y) * invDir.y;
+  vec4 z0 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 4)) - org.z) * invDir.z;
+  vec4 z1 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 5)) - org.z) * invDir.z;
+  ref = texelFetch(bvhWideTexels, base + 6);
+  vec4 hx = max(x0, x1), hy = max(y0, y1), hz = max(z0, z1);
+  hx = mix(hx, vec4(3.0e38), equal(hx, vec4(0.0)));
+  hy = mix(hy, vec4(3.0e38), equal(hy, vec4(0.0)));
+  hz = mix(hz, vec4(3.0e38), equal(hz, vec4(0.0)));
+  vec4 tnear = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), vec4(0.0)));
+  vec4 tfar = min(min(hx, hy), min(hz, vec4(tmax))) * kBvhBoxPad;
+  bvec4 entered = lessThanEqual(tnear, tfar);
+  t = mix(vec4(kBvhMissT), tnear, entered);
+  bvhSortPair(t.x, ref.x, t.y, ref.y);
+  bvhSortPair(t.z, ref.z, t.w, ref.w);
+  bvhSortPair(t.x, ref.x, t.z, ref.z);
+  bvhSortPair(t.y, ref.y, t.w, ref.w);
+  bvhSortPair(t.y, ref.y, t.z, ref.z);
+  uvec4 e = uvec4(entered);
+  return e.x + e.y + e.z + e.w;
+}
+
 // The two-level traversal (traceInstanced) and the instances' world-space triangles (instances.glsl,
 // empty without CAUSTICA_INSTANCED). Included always: the shader library expands #include before the
 // preprocessor runs, and a file is expanded once.
@@ -86,29 +137,35 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   vec3 invDir = safeInverse(dir);
   RayShear rs = makeRayShear(dir);
 
-  uint stackRef[CAUSTICA_BVH_STACK];
-  float stackT[CAUSTICA_BVH_STACK];
+  // (ref, entry distance as float bits) in one array rather than two, and only the kept entries
+  // pushed: together ~10-15 % less CPU on llvmpipe than two arrays and three unconditional writes
+  // (docs/benchmarks.md, 4-wide BVH).
+  uvec2 stack[CAUSTICA_BVH_WIDE_STACK];
   uint sp = 0u;
   uint ref = 0u;  // the root, an inner node
   while (true) {
     // Inner nodes until this lane holds a leaf (an empty stack ends as the empty leaf kBvhEmptyRef).
     while ((ref & kBvhLeafBit) == 0u) {
-      uint near, far;
-      float farT;
-      uint hits = bvhVisitNode(ref, org, invDir, hit.t, near, far, farT);
-      if (hits == 2u && sp < uint(CAUSTICA_BVH_STACK)) {
-        stackRef[sp] = far;
-        stackT[sp] = farT;
-        ++sp;
+      uvec4 r;
+      vec4 t;
+      uint hits = bvhVisitWide(ref, org, invDir, hit.t, r, t);
+      // Entered children 1..hits-1, farthest first so that child 1 ends on top (packBvhWideNodes
+      // guarantees sp + 3 <= the stack size; the check only guards memory).
+      if (hits > 1u && sp + 3u <= uint(CAUSTICA_BVH_WIDE_STACK)) {
+        uvec4 tb = floatBitsToUint(t);
+        if (hits == 4u) stack[sp++] = uvec2(r.w, tb.w);
+        if (hits >= 3u) stack[sp++] = uvec2(r.z, tb.z);
+        stack[sp++] = uvec2(r.y, tb.y);
       }
       if (hits > 0u) {
-        ref = near;
+        ref = r.x;
       } else {
         ref = kBvhEmptyRef;
         while (sp > 0u) {
           --sp;
-          if (stackT[sp] <= hit.t * kBvhBoxPad) {
-            ref = stackRef[sp];
+          uvec2 e = stack[sp];
+          if (uintBitsToFloat(e.y) <= hit.t * kBvhBoxPad) {
+            ref = e.x;
             break;
           }
         }
@@ -131,8 +188,9 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
     ref = kInvalidIndex;
     while (sp > 0u) {
       --sp;
-      if (stackT[sp] <= hit.t * kBvhBoxPad) {
-        ref = stackRef[sp];
+      uvec2 e = stack[sp];
+      if (uintBitsToFloat(e.y) <= hit.t * kBvhBoxPad) {
+        ref = e.x;
         break;
       }
     }
@@ -148,17 +206,21 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   vec3 invDir = safeInverse(dir);
   RayShear rs = makeRayShear(dir);
 
-  uint stackRef[CAUSTICA_BVH_STACK];
+  uint stackRef[CAUSTICA_BVH_WIDE_STACK];
   uint sp = 0u;
   uint ref = 0u;
   while (true) {
     while ((ref & kBvhLeafBit) == 0u) {
-      uint near, far;
-      float farT;
-      uint hits = bvhVisitNode(ref, org, invDir, tmax, near, far, farT);
-      if (hits == 2u && sp < uint(CAUSTICA_BVH_STACK)) stackRef[sp++] = far;
+      uvec4 r;
+      vec4 t;
+      uint hits = bvhVisitWide(ref, org, invDir, tmax, r, t);
+      if (hits > 1u && sp + 3u <= uint(CAUSTICA_BVH_WIDE_STACK)) {
+        if (hits == 4u) stackRef[sp++] = r.w;
+        if (hits >= 3u) stackRef[sp++] = r.z;
+        stackRef[sp++] = r.y;
+      }
       if (hits > 0u) {
-        ref = near;
+        ref = r.x;
       } else if (sp > 0u) {
         ref = stackRef[--sp];
       } else {

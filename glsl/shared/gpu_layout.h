@@ -35,6 +35,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_TEXUNIT_ENV_MARGINAL 1 // texture unit: rgba32f height x 1 (r: marginal CDF over rows)
 #define CAUSTICA_TEXUNIT_BVH_NODES 2   // texture unit: buffer texture (rgba32ui) over the nodes SSBO's buffer, 4 texels per BvhNode
 #define CAUSTICA_TEXUNIT_TRI_GEOM 3    // texture unit: buffer texture (rgba32ui) over the TriGeom buffer, 3 texels per triangle
+#define CAUSTICA_TEXUNIT_BVH_WIDE 6    // texture unit: buffer texture (rgba32ui) over the BvhWideNode buffer, 7 texels per node
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
@@ -50,6 +51,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_WORKGROUP_X 8        // compute work-group size in pixels
 #define CAUSTICA_WORKGROUP_Y 8
 #define CAUSTICA_BVH_STACK 64         // traversal stack entries; the builder guarantees depth < this
+#define CAUSTICA_BVH_WIDE_STACK 192   // 4-wide traversal stack entries: <= 3 pushes per binary level, checked by packBvhWideNodes
 
 CAUSTICA_CONST uint kInvalidIndex = 0xffffffffu;
 
@@ -95,6 +97,22 @@ CAUSTICA_CONST uint kBvhCountShift = 27u;
 CAUSTICA_CONST uint kBvhFirstMask = 0x07ffffffu;  // first triangle of a leaf: < 2^27
 CAUSTICA_CONST uint kBvhMaxLeafSize = 15u;         // 4 bits of count
 CAUSTICA_CONST uint kBvhEmptyRef = 0x80000000u;    // a leaf of no triangles
+
+// 112-byte 4-wide BVH node (7 RGBA32 texels of the buffer texture CAUSTICA_TEXUNIT_BVH_WIDE), made by
+// collapsing the binary SAH tree (app/accel/bvh_wide.*): the boxes of up to four children, stored
+// structure-of-arrays (component k of each vector is child k) so one node fetch tests all four slabs
+// with vec4 arithmetic. child[k] is a ref as in BvhNode (inner node index, or a packed leaf); an
+// unused slot is kBvhEmptyRef with the box (+inf, +inf) on every axis, which no ray enters.
+// Children are packed in no particular order; the traversal sorts them by entry distance.
+struct BvhWideNode {
+  vec4 minX;    // children's world-space AABB minimum x
+  vec4 maxX;    // maximum x
+  vec4 minY;
+  vec4 maxY;
+  vec4 minZ;
+  vec4 maxZ;
+  uvec4 child;  // child refs (kBvhLeafBit: leaf; kBvhEmptyRef: unused slot)
+};
 
 // Instancing (docs/instancing.md): one record per instance, in
 // top-level leaf order, 64 bytes = 4 RGBA32 texels, meant to follow the BVH nodes in their buffer
@@ -277,6 +295,7 @@ static_assert(sizeof(PointLights) == 16 + 64 * CAUSTICA_MAX_POINT_LIGHTS, "Point
 static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std140)");
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 64, "BvhNode must be 64 bytes (4 texels)");
+static_assert(sizeof(BvhWideNode) == 112, "BvhWideNode must be 112 bytes (7 texels)");
 static_assert(sizeof(InstanceRecord) == 64, "InstanceRecord must be 64 bytes (4 texels)");
 static_assert(sizeof(InstanceShade) == 64, "InstanceShade must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");

@@ -1,5 +1,5 @@
-// traverse_gpu_test.cpp — the GLSL BVH traversal (glsl/tests/trace_test.comp on llvmpipe) returns the same
-// hits as its C++ twin, ray for ray, on the bunny, a Cornell box and a random soup.
+// traverse_gpu_test.cpp — the GLSL BVH traversal (glsl/tests/trace_test.comp on llvmpipe, 4-wide nodes)
+// returns the same hits as its C++ twin, ray for ray, on the bunny, a Cornell box and a random soup.
 #include <doctest/doctest.h>
 
 #include <array>
@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "accel/bvh.h"
+#include "accel/bvh_wide.h"
 #include "accel/spawn.h"
 #include "accel/tlas.h"
 #include "gpu/bvh_textures.h"
@@ -50,7 +51,8 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std
   ExpandedShader src = lib.expand("tests/trace_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
   prog.use();
-  BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test");
+  BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test",
+                       packBvhWideNodes(bvh.nodes).nodes);
   textures.bind();
   geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);
   rayBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 8);
@@ -94,16 +96,17 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
   std::vector<std::uint32_t> occ;
   traceOnGpu(bvh, geom, rays, hits, occ);
 
+  const std::vector<gpu::BvhWideNode> wide = packBvhWideNodes(bvh.nodes).nodes;
   int mismatches = 0, hitCount = 0;
   for (int i = 0; i < rayCount; ++i) {
-    Hit h = traceClosest(bvh.nodes, geom, cpuRays[i], tmaxes[i]);
+    Hit h = traceClosest(wide, geom, cpuRays[i], tmaxes[i]);
     std::uint32_t gpuTri = glm::floatBitsToUint(hits[i].w);
     bool gpuOcc = occ[i] != 0;
     bool same = h.tri == gpuTri && (!h.found() || std::abs(h.t - hits[i].x) <= 1e-5f * std::max(1.0f, h.t));
     // Ties between coplanar triangles at the same t may pick either one.
     if (!same && h.found() && gpuTri != gpu::kInvalidIndex && std::abs(h.t - hits[i].x) <= 1e-5f * std::max(1.0f, h.t))
       same = true;
-    if (!same || gpuOcc != traceOccluded(bvh.nodes, geom, cpuRays[i], tmaxes[i])) ++mismatches;
+    if (!same || gpuOcc != traceOccluded(wide, geom, cpuRays[i], tmaxes[i])) ++mismatches;
     hitCount += h.found();
   }
   INFO(mismatches, " of ", rayCount, " rays differ");
@@ -176,11 +179,13 @@ TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never e
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
   traceOnGpu(bvh, geom, rays, hits, occ);
+  const BvhWide wide = packBvhWideNodes(bvh.nodes);
   int gpuEscapes = 0, cpuEscapes = 0, gpuOccMisses = 0;
   for (int k = 0; k < rayCount; ++k) {
     gpuEscapes += glm::floatBitsToUint(hits[k].w) == gpu::kInvalidIndex;
     gpuOccMisses += occ[k] == 0u;
     cpuEscapes += !traceClosest(bvh.nodes, geom, cpu[k], 1e30f).found();
+    cpuEscapes += !traceClosest(wide.nodes, geom, cpu[k], 1e30f).found();
   }
   CHECK(gpuEscapes == 0);
   CHECK(gpuOccMisses == 0);
