@@ -193,8 +193,9 @@ struct FrameParams {
   vec4 camForward;  // xyz: unit viewing direction
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
   uvec4 options;    // x: max depth, y: live tiles in the tile list (0: the dispatch covers `tile`; else one
-                    //    8x8 work group per listed tile, adaptive sampling), z: emitter count, w: unused (the integrator
-                    //    and dispersion mode are shader variants, not flags)
+                    //    8x8 work group per listed tile, adaptive sampling), z: emitter count, w: samples per pixel
+                    //    of this dispatch (pathtrace.comp; indices z .. z + w - 1; the integrator and dispersion
+                    //    mode are shader variants, not flags)
   uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
   vec4 lights;      // x: total emitter weight (sum of luminance * area * sides); yzw unused
 };
