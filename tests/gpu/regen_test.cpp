@@ -165,27 +165,30 @@ TEST_CASE("path regeneration: samples per dispatch stay within llvmpipe's loop c
 
 TEST_CASE("path regeneration: deep paths lose no energy at the largest samples per dispatch asked for") {
   // A closed furnace of albedo 1 emitting 1: Russian roulette never ends a path (its throughput stays
-  // 1), so every naive path runs to the depth cap and collects exactly 1 per bounce: every pixel is
-  // exactly the depth cap. Asking for 64 samples per dispatch must not let llvmpipe's loop cap cut a
-  // path short (without the bound in samplesPerDispatch(), 16 paths of 1024 bounces per lane do).
+  // 1), so a naive path runs to the depth cap and collects exactly 1 per bounce (a few end early, lost
+  // through the box's edges or below the surface: the mean is 0.06 % low at depth 256 and 0.25 % at
+  // 1024, with one sample per dispatch as with four). llvmpipe's loop cap,
+  // once hit, ends a lane's loop early: its remaining samples are missing from the pixel's count and its
+  // paths are cut short. Asking for 64 samples per dispatch must not let that happen (without the bound
+  // in samplesPerDispatch(), 16 paths of 256 or 1024 bounces per lane do hit it).
   Scene scene = loadScene(sourcePath("tests/data/scenes/furnace.gltf"));
   for (Material& m : scene.materials) m.baseColor = glm::vec4(1.0f);
+  const int spp = 16;
   for (int depth : {256, 1024}) {
     RenderSettings rs = small(Integrator::Naive);
     rs.width = rs.height = 16;
     rs.maxDepth = depth;
     rs.samplesPerDispatch = 64;
     Renderer r(library(), scene, sceneCamera(scene), rs);
-    r.renderPass(16);
+    r.renderPass(spp);
+    AccumulationState st = r.saveAccumulation();
+    int shortCount = 0;
+    for (size_t i = 0; i < st.accum.size(); i += 4) shortCount += st.accum[i + 3] - st.comp[i + 3] != float(spp);
     Image img = r.image();
-    float lo = 1e30f, hi = 0.0f;
-    for (float v : img.rgb) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-    INFO("depth ", depth, ", ", r.samplesPerDispatch(), " per dispatch, pixels ", lo, " to ", hi);
-    CHECK(lo == Rel(depth, 1e-4));
-    CHECK(hi == Rel(depth, 1e-4));
+    INFO("depth ", depth, ", ", r.samplesPerDispatch(), " per dispatch, mean ", meanOf(img), ", pixels with too few samples ",
+         shortCount);
+    CHECK(shortCount == 0);
+    CHECK(meanOf(img) == Rel(depth, 0.005));
     CHECK(r.stats().nonFinite == 0);
   }
 }
