@@ -25,12 +25,16 @@ using namespace caustica;
 namespace {
 
 const char* kUsage =
-    "usage: bvh_bench [--csv FILE] [--threads N] [--help]\n"
+    "usage: bvh_bench [--csv FILE] [--threads N] [--quick] [--repeats R] [--no-trace] [--mesh bunny|sphere1M|sphere4M]\n"
+    "                 [--help]\n"
     "Builds BVHs over the bunny (assets/meshes/bunny.obj) and a ~1M-triangle displaced sphere with\n"
     "several (bins, maxLeafSize) settings and prints build time, Mtris/s, SAH cost, nodes, leaves,\n"
     "depth and single-thread traceClosest speed on random rays (builds: best of several, wall time\n"
     "and CPU time of all threads; Mtris/s from wall time). --threads N builds with 1 and N threads\n"
-    "(default: the hardware's count). --csv FILE also writes the table.\n";
+    "(default: the hardware's count). --csv FILE also writes the table. --quick: only 16 bins, leaf 4.\n"
+    "--repeats R: builds per setting (default 5 bunny, 3 sphere). --no-trace: skip the rays.\n"
+    "--mesh: only that mesh (sphere4M: 4,190,208 triangles, only on request). The last column is a hash\n"
+    "(FNV-1a) of the nodes and the leaf order: equal hashes, equal trees.\n";
 
 
 // UV sphere of radius ~1 with a bumpy displacement: 2 * nu * (nv - 1) triangles (one per pole cell).
@@ -52,7 +56,7 @@ std::vector<Triangle> displacedSphere(int nu, int nv) {
   return tris;
 }
 
-// Processor time of this (single-threaded) program in seconds: unlike wall time, it is not inflated
+// Processor time of this process (all its threads) in seconds: unlike wall time, it is not inflated
 // by other processes competing for the cores.
 double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 
@@ -64,7 +68,15 @@ struct Row {
   std::size_t nodes;
   int leaves, depth;
   double mrays, hitFraction;
+  std::uint64_t hash;
 };
+
+// FNV-1a over bytes: compares trees of two builders (same hash: same nodes and leaf order, bit for bit).
+std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t h = 1469598103934665603ull) {
+  const unsigned char* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
 
 // Rays from a sphere around the mesh (3x its bounding radius) towards random points in its bounds.
 std::vector<Ray> randomRays(const std::vector<Triangle>& tris, int count) {
@@ -107,16 +119,20 @@ Row measure(const std::string& name, const std::vector<Triangle>& tris, const st
   std::size_t hits = 0;
   const double t0 = cpuSeconds();
   for (const Ray& r : rays) hits += traceClosest(bvh.nodes, geom, r).found();
-  const double traceS = cpuSeconds() - t0;
+  const double traceS = rays.empty() ? 1.0 : cpuSeconds() - t0;
+  const std::uint64_t hash = fnv1a(bvh.order.data(), bvh.order.size() * sizeof(std::uint32_t),
+                                   fnv1a(bvh.nodes.data(), bvh.nodes.size() * sizeof(gpu::BvhNode)));
   return {name,         tris.size(),          bins,       leaf, threads, best * 1e3, bestCpu * 1e3, double(tris.size()) / best * 1e-6,
           bvh.sahCost,  bvh.nodes.size(),     bvh.leafCount, bvh.depth, double(rays.size()) / traceS * 1e-6,
-          double(hits) / double(rays.size())};
+          rays.empty() ? 0.0 : double(hits) / double(rays.size()), hash};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string csvPath;
+  std::string csvPath, onlyMesh;
+  bool quick = false, trace = true;
+  int repeats = 0;
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
@@ -124,6 +140,14 @@ int main(int argc, char** argv) {
       return 0;
     } else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) {
       csvPath = argv[++i];
+    } else if (!std::strcmp(argv[i], "--quick")) {
+      quick = true;
+    } else if (!std::strcmp(argv[i], "--no-trace")) {
+      trace = false;
+    } else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) {
+      repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (!std::strcmp(argv[i], "--mesh") && i + 1 < argc) {
+      onlyMesh = argv[++i];
     } else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
       threads = std::atoi(argv[++i]);
       if (threads < 1) {
@@ -142,24 +166,29 @@ int main(int argc, char** argv) {
       int rays, repeats;
     };
     std::vector<Mesh> meshes;
-    meshes.push_back({"bunny", loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj"), 200000, 5});
-    meshes.push_back({"sphere1M", displacedSphere(1024, 512), 100000, 3});
+    if (onlyMesh.empty() || onlyMesh == "bunny")
+      meshes.push_back({"bunny", loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj"), 200000, 5});
+    if (onlyMesh.empty() || onlyMesh == "sphere1M") meshes.push_back({"sphere1M", displacedSphere(1024, 512), 100000, 3});
+    if (onlyMesh == "sphere4M") meshes.push_back({"sphere4M", displacedSphere(2048, 1024), 100000, 3});
+    if (meshes.empty()) throw Error("--mesh must be bunny, sphere1M or sphere4M");
 
     std::vector<Row> rows;
-    std::printf("%-9s %9s %4s %4s %3s %9s %9s %8s %8s %9s %8s %5s %8s %5s\n", "mesh", "tris", "bins", "leaf", "thr",
-                "build_ms", "cpu_ms", "Mtris/s", "SAH", "nodes", "leaves", "depth", "Mrays/s", "hit%");
+    std::printf("%-9s %9s %4s %4s %3s %9s %9s %8s %8s %9s %8s %5s %8s %5s %16s\n", "mesh", "tris", "bins", "leaf", "thr",
+                "build_ms", "cpu_ms", "Mtris/s", "SAH", "nodes", "leaves", "depth", "Mrays/s", "hit%", "hash");
     for (const Mesh& m : meshes) {
-      const std::vector<Ray> rays = randomRays(m.tris, m.rays);
-      for (int bins : {8, 16, 32})
-        for (int leaf : {1, 2, 4, 8})
+      const std::vector<Ray> rays = trace ? randomRays(m.tris, m.rays) : std::vector<Ray>{};
+      const std::vector<int> binChoices = quick ? std::vector<int>{16} : std::vector<int>{8, 16, 32};
+      const std::vector<int> leafChoices = quick ? std::vector<int>{4} : std::vector<int>{1, 2, 4, 8};
+      for (int bins : binChoices)
+        for (int leaf : leafChoices)
           for (int thr : {1, threads}) {
             if (thr == threads && threads == 1 && !rows.empty() && rows.back().threads == 1 && rows.back().leaf == leaf &&
                 rows.back().bins == bins && rows.back().mesh == m.name)
               continue;  // --threads 1: one row per setting
-            const Row r = measure(m.name, m.tris, rays, bins, leaf, thr, m.repeats);
-            std::printf("%-9s %9zu %4d %4d %3d %9.2f %9.2f %8.2f %8.2f %9zu %8d %5d %8.3f %5.1f\n", r.mesh.c_str(), r.tris,
-                        r.bins, r.leaf, r.threads, r.buildMs, r.cpuMs, r.mtris, r.sah, r.nodes, r.leaves, r.depth, r.mrays,
-                        100.0 * r.hitFraction);
+            const Row r = measure(m.name, m.tris, rays, bins, leaf, thr, repeats > 0 ? repeats : m.repeats);
+            std::printf("%-9s %9zu %4d %4d %3d %9.2f %9.2f %8.2f %8.4f %9zu %8d %5d %8.3f %5.1f %016llx\n", r.mesh.c_str(),
+                        r.tris, r.bins, r.leaf, r.threads, r.buildMs, r.cpuMs, r.mtris, r.sah, r.nodes, r.leaves, r.depth,
+                        r.mrays, 100.0 * r.hitFraction, (unsigned long long)r.hash);
             std::fflush(stdout);
             rows.push_back(r);
           }

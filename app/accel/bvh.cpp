@@ -1,15 +1,21 @@
-// bvh.cpp — binned-SAH BVH builder (a binary tree, packed into 64-byte gpu::BvhNode) and the C++ twins of the
+// bvh.cpp — binned-SAH BVH builder (writes 64-byte gpu::BvhNode directly, on threads) and the C++ twins of the
 // GLSL ray–triangle test (intersect.glsl) and stack traversal (traverse.glsl). All positions and
 // distances are in world space; t is measured in units of |ray.dir|.
 #include "accel/bvh.h"
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
+#include <memory>
+#include <new>
 #include <exception>
 #include <mutex>
 #include <thread>
 #include <cmath>
 #include <string>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 #include "accel/ray_box.h"
 #include "accel/spawn.h"
@@ -29,8 +35,14 @@ constexpr int kMaxBins = 64;
 typedef float F4 __attribute__((vector_size(16)));
 typedef std::int32_t I4 __attribute__((vector_size(16)));
 inline F4 splat(float x) { return F4{x, x, x, x}; }
+#if defined(__SSE__)
+// minps/maxps compute exactly a < b ? a : b and a > b ? a : b per lane (GCC otherwise emits compare + blend).
+inline F4 vmin(F4 a, F4 b) { return F4(_mm_min_ps(__m128(a), __m128(b))); }
+inline F4 vmax(F4 a, F4 b) { return F4(_mm_max_ps(__m128(a), __m128(b))); }
+#else
 inline F4 vmin(F4 a, F4 b) { return a < b ? a : b; }
 inline F4 vmax(F4 a, F4 b) { return a > b ? a : b; }
+#endif
 
 // Axis-aligned box in world space. An empty box has lo = +inf, hi = -inf, which grow() treats as neutral.
 struct Box {
@@ -96,8 +108,8 @@ struct Split {
   bool found() const { return axis >= 0 && std::isfinite(cost); }
 };
 
-// A node still to be built: its slot in the node array, its range of prims, its level, the bounds
-// of its prims and the bounds of their centroids.
+// A node still to be built (an inner node): its slot in the node array being written, its range of
+// prims, its level (root = 1), the bounds of its prims and the bounds of their centroids.
 struct WorkItem {
   std::uint32_t node;
   std::uint32_t first;
@@ -116,7 +128,7 @@ int medianLevels(std::uint64_t n, std::uint64_t leaf) {
 }
 
 // Bounds and centroid bounds of prims [first, first + count).
-void boundsOfRange(const std::vector<Prim>& prims, std::uint32_t first, std::uint32_t count, Box& box, Box& cbox) {
+void boundsOfRange(const Prim* prims, std::uint32_t first, std::uint32_t count, Box& box, Box& cbox) {
   box = Box{};
   cbox = Box{};
   for (std::uint32_t i = first; i < first + count; ++i) {
@@ -143,148 +155,282 @@ Box triangleBox(const Triangle& tri) {
 
 namespace {
 
-// Shared state of one build: the prims (each subtree owns a disjoint range), the node array (sized for
-// the largest possible tree; each subtree writes only the nodes it allocates) and the next free node.
+typedef Bin Bins[3][kMaxBins];
+
+// Ref of a leaf over prims [first, first + count) (gpu_layout.h, BvhNode).
+inline std::uint32_t leafRef(std::uint32_t first, std::uint32_t count) {
+  if (first > gpu::kBvhFirstMask || count > gpu::kBvhMaxLeafSize || count == 0)
+    throw Error("bvh.cpp: leaf out of the packed range (internal error)");
+  return gpu::kBvhLeafBit | count << gpu::kBvhCountShift | first;
+}
+
+// Runs fn(t) for t in [0, threads), t = 0 on the calling thread, and rethrows the first exception.
+template <class Fn>
+void runOnThreads(unsigned threads, const Fn& fn) {
+  std::exception_ptr failure;
+  std::mutex failureMutex;
+  auto guarded = [&](unsigned t) {
+    try {
+      fn(t);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failureMutex);
+      if (!failure) failure = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(guarded, t);
+  guarded(0);
+  for (std::thread& th : pool) th.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+// Settings and shared inputs of one build. Every subtree owns a disjoint range of `prims`.
 struct BuildContext {
-  std::vector<Prim>& prims;
-  std::vector<BvhBinaryNode>& nodes;
-  std::atomic<std::uint32_t> nextNode{1};
+  Prim* prims = nullptr;
   int bins = 16;
   std::uint32_t maxLeaf = 4;
   double ct = 1.0, ci = 1.0;
   double rootArea = 1.0;
   bool rootAreaOk = false;
+  unsigned threads = 1;  // for binning the large nodes at the top of the tree
 };
 
-// Depth, leaf count and SAH cost (relative to the root's area) of a built part of the tree.
+// Depth, leaf count and SAH cost (relative to the root's surface area) of a built part of the tree.
 struct BuildStats {
   int depth = 0;
   int leafCount = 0;
   double sah = 0.0;
 };
 
-// Builds the subtree of `root` depth-first. With `deferred`, nodes of fewer than deferBelow prims are
-// not built but appended to it (their node slots and prim ranges are already theirs).
-void buildSubtree(BuildContext& ctx, const WorkItem& root, BuildStats& st, std::vector<WorkItem>* deferred,
-                  std::uint32_t deferBelow) {
-  const int bins = ctx.bins;
+// Nodes at least this large are binned on all threads (top of the tree in a threaded build).
+constexpr std::uint32_t kParallelBinMin = 1u << 15;
+
+// Per-axis bin scales: bins / centroid extent, 0 on a flat (or overflowing) axis, which is then not binned.
+F4 binScale(const Box& cbox, int bins, bool& anyAxis) {
+  F4 scale = splat(0.0f);
+  anyAxis = false;
+  for (int a = 0; a < 3; ++a) {
+    const float s = float(bins) / (cbox.hi[a] - cbox.lo[a]);
+    scale[a] = (s > 0.0f && std::isfinite(s)) ? s : 0.0f;
+    anyAxis |= scale[a] > 0.0f;
+  }
+  return scale;
+}
+
+// Adds prims [first, first + count) to the bins of all three axes (flat axes all land in bin 0).
+void binPrims(const Prim* prims, std::uint32_t first, std::uint32_t count, F4 cmin, F4 scale, int nbins, Bins& bins) {
+  const F4 lastBin = splat(float(nbins - 1));
+  for (const Prim *p = prims + first, *end = prims + first + count; p < end; ++p) {
+    const I4 b = binsOf(centroidOf(*p), cmin, scale, lastBin);
+    for (int a = 0; a < 3; ++a) {
+      Bin& bin = bins[a][b[a]];
+      bin.box.grow(p->box);
+      bin.count++;
+    }
+  }
+}
+
+// Binned SAH sweep over the axes with a centroid extent; pos = first bin of the right child. Costs are
+// in units of area * count (the node's own terms are constant). Leaves every bin empty again.
+void sweepBins(Bins& binsPerAxis, F4 scale, int bins, Split& best) {
+  for (int a = 0; a < 3; ++a) {
+    if (scale[a] <= 0.0f) {
+      binsPerAxis[a][0] = Bin{};
+      continue;
+    }
+    // Sweep over the non-empty bins only (planes between empty bins give the same partitions).
+    int used[kMaxBins], m = 0;
+    for (int i = 0; i < bins; ++i) {  // branch-free: the pattern of empty bins is unpredictable
+      used[m] = i;
+      m += binsPerAxis[a][i].count > 0;
+    }
+    double rightCost[kMaxBins];  // area * count of used bins [k, m)
+    int rightCount[kMaxBins];
+    Box acc;
+    int cnt = 0;
+    for (int k = m - 1; k > 0; --k) {
+      const Bin& bin = binsPerAxis[a][used[k]];
+      acc.grow(bin.box);
+      cnt += bin.count;
+      rightCost[k] = acc.halfArea() * cnt;
+      rightCount[k] = cnt;
+    }
+    acc = Box{};
+    cnt = 0;
+    for (int k = 1; k < m; ++k) {
+      const Bin& bin = binsPerAxis[a][used[k - 1]];
+      acc.grow(bin.box);
+      cnt += bin.count;
+      best.consider(a, used[k], acc.halfArea() * cnt + rightCost[k], cnt, rightCount[k]);
+    }
+    for (int k = 0; k < m; ++k) binsPerAxis[a][used[k]] = Bin{};  // all bins empty again
+  }
+}
+
+// Nodes of at most this many prims find their split without the bin arrays (smallSplit).
+// (At most maxLeafSize prims: the leaf-or-split decisions, half of all split searches. Larger values
+// measured no faster on the 1 M sphere.)
+constexpr std::uint32_t kSmallNode = 4;
+
+// The binned-SAH split of a small node, equal to binning and sweeping it (same candidate planes in the
+// same order, same float boxes and double costs), but over its prims sorted by bin instead of over all
+// bins: only the non-empty bins exist, so nothing is scanned or cleared.
+void smallSplit(const Prim* prims, const WorkItem& item, F4 scale, F4 lastBin, Split& best) {
+  const std::uint32_t count = item.count;
+  I4 bin[kSmallNode];
+  for (std::uint32_t i = 0; i < count; ++i) bin[i] = binsOf(centroidOf(prims[item.first + i]), item.cbox.lo, scale, lastBin);
+  for (int a = 0; a < 3; ++a) {
+    if (scale[a] <= 0.0f) continue;
+    int idx[kSmallNode];  // prims by bin on this axis (insertion sort)
+    for (std::uint32_t i = 0; i < count; ++i) {
+      std::uint32_t j = i;
+      for (; j > 0 && bin[idx[j - 1]][a] > bin[i][a]; --j) idx[j] = idx[j - 1];
+      idx[j] = int(i);
+    }
+    // Groups of equal bins: the non-empty bins, in order.
+    Box groupBox[kSmallNode];
+    int groupCount[kSmallNode], groupBin[kSmallNode], m = 0;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const int b = bin[idx[i]][a];
+      if (m == 0 || groupBin[m - 1] != b) {
+        groupBin[m] = b;
+        groupBox[m] = Box{};
+        groupCount[m] = 0;
+        ++m;
+      }
+      groupBox[m - 1].grow(prims[item.first + idx[i]].box);
+      groupCount[m - 1]++;
+    }
+    double rightCost[kSmallNode];
+    int rightCount[kSmallNode];
+    Box acc;
+    int cnt = 0;
+    for (int k = m - 1; k > 0; --k) {
+      acc.grow(groupBox[k]);
+      cnt += groupCount[k];
+      rightCost[k] = acc.halfArea() * cnt;
+      rightCount[k] = cnt;
+    }
+    acc = Box{};
+    cnt = 0;
+    for (int k = 1; k < m; ++k) {
+      acc.grow(groupBox[k - 1]);
+      cnt += groupCount[k - 1];
+      best.consider(a, groupBin[k], acc.halfArea() * cnt + rightCost[k], cnt, rightCount[k]);
+    }
+  }
+}
+
+// Best binned-SAH split of a node. Large nodes are binned on ctx.threads threads: bins merge by
+// min/max and sums, so the result is the single-threaded one exactly.
+Split findSplit(const BuildContext& ctx, const WorkItem& item, Bins& bins, F4& scale) {
+  Split best;
+  bool anyAxis = false;
+  scale = binScale(item.cbox, ctx.bins, anyAxis);
+  if (!anyAxis) return best;
+  const F4 lastBin = splat(float(ctx.bins - 1));
+  if (item.count <= kSmallNode) {
+    smallSplit(ctx.prims, item, scale, lastBin, best);
+    return best;
+  }
+  if (ctx.threads > 1 && item.count >= kParallelBinMin) {
+    const unsigned threads = ctx.threads;
+    std::vector<Bins> partial(threads - 1);  // thread 0 bins into `bins`
+    runOnThreads(threads, [&](unsigned t) {
+      const std::uint32_t lo = item.first + std::uint32_t(std::uint64_t(item.count) * t / threads);
+      const std::uint32_t hi = item.first + std::uint32_t(std::uint64_t(item.count) * (t + 1) / threads);
+      binPrims(ctx.prims, lo, hi - lo, item.cbox.lo, scale, ctx.bins, t == 0 ? bins : partial[t - 1]);
+    });
+    for (const Bins& p : partial)
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < ctx.bins; ++i) {
+          bins[a][i].box.grow(p[a][i].box);
+          bins[a][i].count += p[a][i].count;
+        }
+  } else {
+    binPrims(ctx.prims, item.first, item.count, item.cbox.lo, scale, ctx.bins, bins);
+  }
+  sweepBins(bins, scale, ctx.bins, best);
+  return best;
+}
+
+// Whether a node becomes a leaf: one prim, the depth budget spent, or few enough prims that SAH
+// prefers testing them all to splitting. Larger nodes are inner nodes (their split is found later).
+bool becomesLeaf(const BuildContext& ctx, const WorkItem& item, Bins& bins) {
+  if (item.count == 1 || item.depth >= kMaxLeafDepth) {
+    if (item.count > ctx.maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
+    return true;
+  }
+  if (item.count > ctx.maxLeaf) return false;
+  F4 scale;
+  const Split best = findSplit(ctx, item, bins, scale);
+  const double nodeArea = item.box.halfArea();
+  return !(best.found() && ctx.ct * nodeArea + ctx.ci * best.cost < ctx.ci * double(item.count) * nodeArea);
+}
+
+inline double relativeArea(const BuildContext& ctx, const Box& box) {
+  return ctx.rootAreaOk ? box.halfArea() / ctx.rootArea : 1.0;
+}
+
+// A subtree left for the threaded phase: its root (an inner node) and where the single-threaded
+// build would have numbered its descendants: after `marker` nodes of the top of the tree.
+struct Deferred {
+  WorkItem item;
+  std::uint32_t marker;
+};
+
+// Builds the subtree of the inner node `root` (whose slot out[root.node] exists) depth-first, writing
+// 64-byte nodes straight into `out`: a node's inner children get the next free slots when it is split
+// (left, then right), so the numbering is the depth-first one of packing a finished tree. With
+// `deferred`, inner nodes of fewer than deferBelow prims are not built but appended to it.
+void buildSubtree(const BuildContext& ctx, const WorkItem& root, std::vector<gpu::BvhNode>& out, BuildStats& st,
+                  std::vector<Deferred>* deferred, std::uint32_t deferBelow) {
   const std::uint32_t maxLeaf = ctx.maxLeaf;
-  const double ct = ctx.ct, ci = ctx.ci;
+  const F4 lastBin = splat(float(ctx.bins - 1));
+  Prim* const prims = ctx.prims;
   std::vector<WorkItem> work{root};
-  Bin binsPerAxis[3][kMaxBins];  // kept empty between nodes
-  const F4 lastBin = splat(float(bins - 1));
+  Bins bins;  // kept empty between nodes
   while (!work.empty()) {
     const WorkItem item = work.back();
     work.pop_back();
     if (deferred && item.count < deferBelow) {  // left for the parallel phase
-      deferred->push_back(item);
+      deferred->push_back({item, std::uint32_t(out.size())});
       continue;
     }
-    const double nodeArea = item.box.halfArea();
-    const double relArea = ctx.rootAreaOk ? nodeArea / ctx.rootArea : 1.0;
-    BvhBinaryNode& out = ctx.nodes[item.node];
-    out.bmin = glm::vec3(item.box.lo[0], item.box.lo[1], item.box.lo[2]);
-    out.bmax = glm::vec3(item.box.hi[0], item.box.hi[1], item.box.hi[2]);
-
-    auto makeLeaf = [&]() {
-      if (item.count > maxLeaf) throw Error("bvh.cpp: BVH depth bound violated (internal error)");
-      BvhBinaryNode& leaf = ctx.nodes[item.node];
-      leaf.leftFirst = item.first;
-      leaf.triCount = item.count;
-      st.leafCount++;
-      st.depth = std::max(st.depth, item.depth);
-      st.sah += ci * double(item.count) * relArea;
-    };
-    if (item.count == 1 || item.depth >= kMaxLeafDepth) {
-      makeLeaf();
-      continue;
-    }
-
-    // Axes with a usable centroid extent get binned; flat (or overflowing) axes get scale 0.
-    F4 scale = splat(0.0f);
-    bool anyAxis = false;
-    for (int a = 0; a < 3; ++a) {
-      const float s = float(bins) / (item.cbox.hi[a] - item.cbox.lo[a]);
-      scale[a] = (s > 0.0f && std::isfinite(s)) ? s : 0.0f;
-      anyAxis |= scale[a] > 0.0f;
-    }
-
-    // Binned SAH over the axes with a centroid extent; pos = first bin of the right child. Costs are
-    // in units of area * count (the node's own terms are constant).
-    Split best;
-    if (anyAxis) {
-      for (std::uint32_t i = item.first; i < item.first + item.count; ++i) {
-        const Prim& p = ctx.prims[i];
-        const I4 b = binsOf(centroidOf(p), item.cbox.lo, scale, lastBin);
-        for (int a = 0; a < 3; ++a) {  // flat axes all land in bin 0 and are ignored below
-          Bin& bin = binsPerAxis[a][b[a]];
-          bin.box.grow(p.box);
-          bin.count++;
-        }
-      }
-      for (int a = 0; a < 3; ++a) {
-        if (scale[a] <= 0.0f) {
-          binsPerAxis[a][0] = Bin{};
-          continue;
-        }
-        // Sweep over the non-empty bins only (planes between empty bins give the same partitions).
-        int used[kMaxBins], m = 0;
-        for (int i = 0; i < bins; ++i)
-          if (binsPerAxis[a][i].count > 0) used[m++] = i;
-        double rightCost[kMaxBins];  // area * count of used bins [k, m)
-        int rightCount[kMaxBins];
-        Box acc;
-        int cnt = 0;
-        for (int k = m - 1; k > 0; --k) {
-          const Bin& bin = binsPerAxis[a][used[k]];
-          acc.grow(bin.box);
-          cnt += bin.count;
-          rightCost[k] = acc.halfArea() * cnt;
-          rightCount[k] = cnt;
-        }
-        acc = Box{};
-        cnt = 0;
-        for (int k = 1; k < m; ++k) {
-          const Bin& bin = binsPerAxis[a][used[k - 1]];
-          acc.grow(bin.box);
-          cnt += bin.count;
-          best.consider(a, used[k], acc.halfArea() * cnt + rightCost[k], cnt, rightCount[k]);
-        }
-        for (int k = 0; k < m; ++k) binsPerAxis[a][used[k]] = Bin{};  // all bins empty again
-      }
-    }
-
-    if (item.count <= maxLeaf) {
-      // Small enough for a leaf: split only if SAH says it pays.
-      const bool split = best.found() && ct * nodeArea + ci * best.cost < ci * double(item.count) * nodeArea;
-      if (!split) {
-        makeLeaf();
-        continue;
-      }
-    }
+    F4 scale;
+    const Split best = findSplit(ctx, item, bins, scale);
 
     // Split at the SAH plane unless the depth budget requires a median split (which keeps
     // depth + medianLevels(count) constant, so leaves never pass kMaxLeafDepth).
     const bool forceMedian = item.depth + medianLevels(item.count, maxLeaf) >= kMaxLeafDepth;
-    WorkItem left{0, item.first, 0, item.depth + 1, Box{}, Box{}};
-    WorkItem right{0, 0, 0, item.depth + 1, Box{}, Box{}};
+    WorkItem kid[2] = {{0, item.first, 0, item.depth + 1, Box{}, Box{}}, {0, 0, 0, item.depth + 1, Box{}, Box{}}};
+    WorkItem& left = kid[0];
+    WorkItem& right = kid[1];
     if (best.found() && !forceMedian) {
       // In-place partition; child bounds come from the prims themselves, so they are exact.
+      // (The bounds are accumulated in locals, which stay in registers.)
+      Box lbox, lcbox, rbox, rcbox;
+      const int axis = best.axis, pos = best.pos;
+      const F4 cmin = item.cbox.lo;
       std::uint32_t i = item.first, j = item.first + item.count;
       while (i < j) {
-        const F4 c = centroidOf(ctx.prims[i]);
-        if (binsOf(c, item.cbox.lo, scale, lastBin)[best.axis] < best.pos) {
-          left.box.grow(ctx.prims[i].box);
-          left.cbox.grow(c);
+        const F4 c = centroidOf(prims[i]);
+        if (binsOf(c, cmin, scale, lastBin)[axis] < pos) {
+          lbox.grow(prims[i].box);
+          lcbox.grow(c);
           ++i;
         } else {
           --j;
-          std::swap(ctx.prims[i], ctx.prims[j]);
-          right.box.grow(ctx.prims[j].box);
-          right.cbox.grow(c);
+          std::swap(prims[i], prims[j]);
+          rbox.grow(prims[j].box);
+          rcbox.grow(c);
         }
       }
       left.count = i - item.first;
+      left.box = lbox;
+      left.cbox = lcbox;
+      right.box = rbox;
+      right.cbox = rcbox;
     }
     if (left.count == 0 || left.count == item.count) {
       // Median split along the widest centroid axis (any order when all centroids coincide).
@@ -292,24 +438,43 @@ void buildSubtree(BuildContext& ctx, const WorkItem& root, BuildStats& st, std::
       for (int k = 1; k < 3; ++k)
         if (item.cbox.hi[k] - item.cbox.lo[k] > item.cbox.hi[a] - item.cbox.lo[a]) a = k;
       left.count = item.count / 2;
-      Prim* begin = ctx.prims.data() + item.first;
+      Prim* begin = prims + item.first;
       std::nth_element(begin, begin + left.count, begin + item.count,
                        [a](const Prim& p, const Prim& q) { return centroidOf(p)[a] < centroidOf(q)[a]; });
-      boundsOfRange(ctx.prims, item.first, left.count, left.box, left.cbox);
-      boundsOfRange(ctx.prims, item.first + left.count, item.count - left.count, right.box, right.cbox);
+      boundsOfRange(prims, item.first, left.count, left.box, left.cbox);
+      boundsOfRange(prims, item.first + left.count, item.count - left.count, right.box, right.cbox);
     }
     right.first = item.first + left.count;
     right.count = item.count - left.count;
+    st.sah += ctx.ct * relativeArea(ctx, item.box);
 
-    left.node = ctx.nextNode.fetch_add(2);
-    right.node = left.node + 1;
-    ctx.nodes[item.node].leftFirst = left.node;
-    ctx.nodes[item.node].triCount = 0;
-    st.sah += ct * relArea;
-    work.push_back(right);
-    work.push_back(left);
+    // Children: leaves go into the ref; inner children get the next slots, left first.
+    std::uint32_t ref[2];
+    bool inner[2];
+    for (int k = 0; k < 2; ++k) {
+      inner[k] = !becomesLeaf(ctx, kid[k], bins);
+      if (inner[k]) {
+        kid[k].node = std::uint32_t(out.size());
+        out.emplace_back();
+        ref[k] = kid[k].node;
+      } else {
+        ref[k] = leafRef(kid[k].first, kid[k].count);
+        st.leafCount++;
+        st.depth = std::max(st.depth, kid[k].depth);
+        st.sah += ctx.ci * double(kid[k].count) * relativeArea(ctx, kid[k].box);
+      }
+    }
+    gpu::BvhNode& n = out[item.node];
+    n.lmin = glm::vec3(left.box.lo[0], left.box.lo[1], left.box.lo[2]);
+    n.lmax = glm::vec3(left.box.hi[0], left.box.hi[1], left.box.hi[2]);
+    n.rmin = glm::vec3(right.box.lo[0], right.box.lo[1], right.box.lo[2]);
+    n.rmax = glm::vec3(right.box.hi[0], right.box.hi[1], right.box.hi[2]);
+    n.left = ref[0];
+    n.right = ref[1];
+    n.reserved0 = n.reserved1 = 0;
+    if (inner[1]) work.push_back(right);
+    if (inner[0]) work.push_back(left);
   }
-
 }
 
 }  // namespace
@@ -325,144 +490,174 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
 
   Bvh bvh;
   const std::uint32_t n = std::uint32_t(triangles.size());
-
-  if (n == 0) {  // one empty node with an inverted box; packed as a root of two empty slots
-    BvhBinaryNode empty{};
-    empty.bmin = glm::vec3(kInf);
-    empty.bmax = glm::vec3(-kInf);
-    bvh.binary.push_back(empty);
+  gpu::BvhNode emptyRoot{};  // a root of two empty slots (inverted boxes)
+  emptyRoot.lmin = emptyRoot.rmin = glm::vec3(kInf);
+  emptyRoot.lmax = emptyRoot.rmax = glm::vec3(-kInf);
+  emptyRoot.left = emptyRoot.right = gpu::kBvhEmptyRef;
+  if (n == 0) {
+    bvh.nodes.push_back(emptyRoot);
     bvh.depth = 1;
     bvh.leafCount = 1;
-    bvh.nodes = packBvhNodes(bvh.binary);
     return bvh;
   }
 
-  std::vector<Prim> prims;
-  prims.reserve(n);
-  for (std::uint32_t i = 0; i < n; ++i) prims.emplace_back(triangleBox(triangles[i]), i);
+  unsigned threads = options.threads > 0 ? unsigned(options.threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (n < 65536) threads = 1;  // small meshes: starting threads costs more than it saves
 
-  bvh.binary.resize(2 * std::size_t(n) - 1);  // the most nodes a binary tree over n prims can have
-  BuildContext ctx{prims, bvh.binary};
+  // Prims (uninitialised storage, filled in parallel) and the root's bounds, merged from per-thread parts.
+  struct FreeDeleter {
+    void operator()(Prim* p) const { std::free(p); }
+  };
+  std::unique_ptr<Prim, FreeDeleter> primStore(static_cast<Prim*>(std::aligned_alloc(alignof(Prim), sizeof(Prim) * std::size_t(n))));
+  if (!primStore) throw std::bad_alloc();
+  Prim* const prims = primStore.get();
+  std::vector<Box> partBox(threads), partCbox(threads);
+  runOnThreads(threads, [&](unsigned t) {
+    const std::uint32_t lo = std::uint32_t(std::uint64_t(n) * t / threads), hi = std::uint32_t(std::uint64_t(n) * (t + 1) / threads);
+    Box box, cbox;
+    for (std::uint32_t i = lo; i < hi; ++i) {
+      Prim* p = new (prims + i) Prim(triangleBox(triangles[i]), i);
+      box.grow(p->box);
+      cbox.grow(centroidOf(*p));
+    }
+    partBox[t] = box;
+    partCbox[t] = cbox;
+  });
+  WorkItem root{0, 0, n, 1, Box{}, Box{}};
+  for (unsigned t = 0; t < threads; ++t) {
+    root.box.grow(partBox[t]);
+    root.cbox.grow(partCbox[t]);
+  }
+  root.box.lo[3] = root.box.hi[3] = root.cbox.lo[3] = root.cbox.hi[3] = 0.0f;  // lanes 3 carried the indices
+
+  BuildContext ctx;
+  ctx.prims = prims;
   ctx.bins = options.bins;
   ctx.maxLeaf = std::uint32_t(options.maxLeafSize);
   ctx.ct = options.costTraversal;
   ctx.ci = options.costIntersect;
-  WorkItem root{0, 0, n, 1, Box{}, Box{}};
-  boundsOfRange(prims, 0, n, root.box, root.cbox);
   ctx.rootArea = root.box.halfArea();
   ctx.rootAreaOk = ctx.rootArea > 0.0 && std::isfinite(ctx.rootArea);
+  ctx.threads = threads;
 
-  // The top of the tree on this thread, down to subtrees of fewer than n / (8 * threads) prims; those
-  // are then built by `threads` threads, largest first. Every subtree owns its prim range and the
-  // nodes it allocates, so the tree (shape, boxes, leaf order) is the one a single thread builds; only
-  // the binary node numbering depends on scheduling, and packBvhNodes renumbers depth-first.
-  unsigned threads = options.threads > 0 ? unsigned(options.threads) : std::max(1u, std::thread::hardware_concurrency());
-  if (n < 65536) threads = 1;  // small meshes: starting threads costs more than it saves
-  BuildStats top;
-  std::vector<WorkItem> deferred;
-  buildSubtree(ctx, root, top, threads > 1 ? &deferred : nullptr, std::max<std::uint32_t>(1, n / (8 * threads)));
-  std::sort(deferred.begin(), deferred.end(), [](const WorkItem& x, const WorkItem& y) {
-    return x.count != y.count ? x.count > y.count : x.first < y.first;
-  });
-  std::vector<BuildStats> stats(deferred.size());
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr failure;
-  std::mutex failureMutex;
-  auto worker = [&]() {
-    try {
-      for (std::size_t k = next.fetch_add(1); k < deferred.size(); k = next.fetch_add(1))
-        buildSubtree(ctx, deferred[k], stats[k], nullptr, 0);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(failureMutex);
-      if (!failure) failure = std::current_exception();
+  Bins rootBins;
+  double sah = 0.0;
+  if (becomesLeaf(ctx, root, rootBins)) {  // one leaf: a root holding it and an empty slot
+    gpu::BvhNode r = emptyRoot;
+    r.lmin = glm::vec3(root.box.lo[0], root.box.lo[1], root.box.lo[2]);
+    r.lmax = glm::vec3(root.box.hi[0], root.box.hi[1], root.box.hi[2]);
+    r.left = leafRef(0, n);
+    bvh.nodes.push_back(r);
+    bvh.depth = 1;
+    bvh.leafCount = 1;
+    sah = ctx.ci * double(n);
+  } else if (threads == 1) {
+    // One thread: the nodes go straight into place. n slots bound the inner nodes; reserving them
+    // only reserves address space (pages are touched as nodes are written).
+    bvh.nodes.reserve(n);
+    bvh.nodes.emplace_back();
+    BuildStats st;
+    buildSubtree(ctx, root, bvh.nodes, st, nullptr, 0);
+    sah = st.sah;
+    bvh.depth = st.depth;
+    bvh.leafCount = st.leafCount;
+  } else {
+    // The top of the tree on this thread (large nodes binned on all threads), down to subtrees of
+    // fewer than n / (8 * threads) prims; those are built by all threads, largest first, each into its
+    // own array, then spliced in where the single-threaded build numbers them. The result is the
+    // single-threaded tree bit for bit.
+    std::vector<gpu::BvhNode> top{gpu::BvhNode{}};
+    std::vector<Deferred> deferred;
+    BuildStats topStats;
+    buildSubtree(ctx, root, top, topStats, &deferred, std::max<std::uint32_t>(2, n / (8 * threads)));
+    const std::size_t d = deferred.size();
+    std::vector<std::uint32_t> schedule(d);
+    for (std::size_t k = 0; k < d; ++k) schedule[k] = std::uint32_t(k);
+    std::sort(schedule.begin(), schedule.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return deferred[x].item.count != deferred[y].item.count ? deferred[x].item.count > deferred[y].item.count : x < y;
+    });
+    std::vector<std::vector<gpu::BvhNode>> sub(d);
+    std::vector<BuildStats> stats(d);
+    std::atomic<std::size_t> next{0};
+    BuildContext subCtx = ctx;
+    subCtx.threads = 1;
+    runOnThreads(threads, [&](unsigned) {
+      for (std::size_t s = next.fetch_add(1); s < d; s = next.fetch_add(1)) {
+        const std::uint32_t k = schedule[s];
+        WorkItem item = deferred[k].item;
+        item.node = 0;
+        sub[k].reserve(item.count);  // address space only, as above
+        sub[k].emplace_back();
+        buildSubtree(subCtx, item, sub[k], stats[k], nullptr, 0);
+      }
+    });
+
+    // Splice: top node t goes to t + (nodes of the blocks spliced in before it); block k (subtree k
+    // without its root, whose slot is in `top`) starts after marker_k top nodes and the earlier blocks.
+    std::vector<std::uint32_t> globalOf(top.size() + 1), base(d);
+    std::vector<std::int32_t> owner(top.size(), -1);
+    {
+      std::size_t k = 0;
+      std::uint32_t shift = 0;
+      for (std::uint32_t t = 0; t <= top.size(); ++t) {
+        for (; k < d && deferred[k].marker == t; ++k) {
+          base[k] = t + shift;
+          shift += std::uint32_t(sub[k].size() - 1);
+        }
+        globalOf[t] = t + shift;
+      }
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads && !deferred.empty(); ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
-
-  double sah = top.sah;
-  bvh.depth = top.depth;
-  bvh.leafCount = top.leafCount;
-  for (const BuildStats& st : stats) {  // in a fixed order, so the sum does not depend on scheduling
-    sah += st.sah;
-    bvh.depth = std::max(bvh.depth, st.depth);
-    bvh.leafCount += st.leafCount;
+    for (std::size_t k = 0; k < d; ++k) owner[deferred[k].item.node] = std::int32_t(k);
+    auto fixTop = [&](std::uint32_t ref) { return (ref & gpu::kBvhLeafBit) ? ref : globalOf[ref]; };
+    auto fixSub = [&](std::uint32_t ref, std::size_t k) { return (ref & gpu::kBvhLeafBit) ? ref : base[k] + ref - 1; };
+    // The top nodes (and the subtrees' roots, in their slots) first, then the blocks on all threads,
+    // each thread copying and freeing whole subtrees.
+    bvh.nodes.resize(globalOf[top.size()]);
+    for (std::uint32_t t = 0; t < top.size(); ++t) {
+      gpu::BvhNode node;
+      if (owner[t] >= 0) {
+        const std::size_t o = std::size_t(owner[t]);
+        node = sub[o][0];
+        node.left = fixSub(node.left, o);
+        node.right = fixSub(node.right, o);
+      } else {
+        node = top[t];
+        node.left = fixTop(node.left);
+        node.right = fixTop(node.right);
+      }
+      bvh.nodes[globalOf[t]] = node;
+    }
+    next = 0;
+    runOnThreads(threads, [&](unsigned) {
+      for (std::size_t s = next.fetch_add(1); s < d; s = next.fetch_add(1)) {
+        const std::uint32_t k = schedule[s];
+        gpu::BvhNode* dst = bvh.nodes.data() + base[k];
+        for (std::size_t j = 1; j < sub[k].size(); ++j) {
+          gpu::BvhNode node = sub[k][j];
+          node.left = fixSub(node.left, k);
+          node.right = fixSub(node.right, k);
+          dst[j - 1] = node;
+        }
+        std::vector<gpu::BvhNode>().swap(sub[k]);
+      }
+    });
+    sah = topStats.sah;
+    bvh.depth = topStats.depth;
+    bvh.leafCount = topStats.leafCount;
+    for (const BuildStats& st : stats) {  // in a fixed order, so the sum does not depend on scheduling
+      sah += st.sah;
+      bvh.depth = std::max(bvh.depth, st.depth);
+      bvh.leafCount += st.leafCount;
+    }
   }
-  bvh.binary.resize(ctx.nextNode.load());
 
   if (bvh.depth >= CAUSTICA_BVH_STACK)
     throw Error("bvh.cpp: BVH depth " + std::to_string(bvh.depth) + " exceeds the traversal stack");
   bvh.sahCost = float(sah);
-  bvh.nodes = packBvhNodes(bvh.binary);
   bvh.order.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
   return bvh;
 }
-
-std::vector<gpu::BvhNode> packBvhNodes(const std::vector<BvhBinaryNode>& binary) {
-  std::vector<gpu::BvhNode> out;
-  if (binary.empty()) return out;
-  const std::uint32_t kEmptyRef = gpu::kBvhEmptyRef;
-  const glm::vec3 inf(kInf);
-  // Ref of binary node b once packed: leaves in place, inner nodes by the index `innerIndex` gives.
-  std::vector<std::uint32_t> innerIndex(binary.size(), gpu::kInvalidIndex);
-  auto leafRef = [&](const BvhBinaryNode& b) {
-    if (b.leftFirst > gpu::kBvhFirstMask || b.triCount > gpu::kBvhMaxLeafSize)
-      throw Error("bvh.cpp: leaf out of the packed range (internal error)");
-    return gpu::kBvhLeafBit | b.triCount << gpu::kBvhCountShift | b.leftFirst;
-  };
-  const BvhBinaryNode& root = binary[0];
-  if (root.triCount > 0 || !(root.bmin.x <= root.bmax.x)) {  // one leaf, or an empty tree
-    gpu::BvhNode n{};
-    const bool empty = root.triCount == 0;
-    n.lmin = empty ? inf : root.bmin;
-    n.lmax = empty ? -inf : root.bmax;
-    n.left = empty ? kEmptyRef : leafRef(root);
-    n.rmin = inf;
-    n.rmax = -inf;
-    n.right = kEmptyRef;
-    out.push_back(n);
-    return out;
-  }
-  // Depth-first, parents before children; a node's children are packed where it is popped.
-  out.reserve(binary.size() / 2 + 1);  // one per inner node: (binary nodes - 1) / 2
-  std::vector<std::uint32_t> work{0};
-  innerIndex[0] = 0;
-  out.emplace_back();
-  while (!work.empty()) {
-    const std::uint32_t b = work.back();
-    work.pop_back();
-    const BvhBinaryNode& node = binary[b];
-    const std::uint32_t l = node.leftFirst, r = node.leftFirst + 1;
-    gpu::BvhNode n{};
-    n.lmin = binary[l].bmin;
-    n.lmax = binary[l].bmax;
-    n.rmin = binary[r].bmin;
-    n.rmax = binary[r].bmax;
-    std::uint32_t refs[2];
-    const std::uint32_t kids[2] = {l, r};
-    for (int k = 0; k < 2; ++k) {
-      const BvhBinaryNode& c = binary[kids[k]];
-      if (c.triCount > 0) {
-        refs[k] = leafRef(c);
-      } else {
-        innerIndex[kids[k]] = std::uint32_t(out.size());
-        refs[k] = innerIndex[kids[k]];
-        out.emplace_back();
-      }
-    }
-    n.left = refs[0];
-    n.right = refs[1];
-    out[innerIndex[b]] = n;
-    for (int k = 1; k >= 0; --k)
-      if (binary[kids[k]].triCount == 0) work.push_back(kids[k]);
-  }
-  return out;
-}
-
 bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3& hi) {
   lo = glm::vec3(kInf);
   hi = glm::vec3(-kInf);
@@ -480,6 +675,39 @@ bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3&
     any = true;
   }
   return any;
+}
+
+double bvhSahCost(const std::vector<gpu::BvhNode>& nodes, float costTraversal, float costIntersect) {
+  if (nodes.empty()) return 0.0;
+  auto halfArea = [](const glm::vec3& lo, const glm::vec3& hi) {
+    const double dx = double(hi.x) - lo.x, dy = double(hi.y) - lo.y, dz = double(hi.z) - lo.z;
+    return dx * dy + dy * dz + dz * dx;
+  };
+  glm::vec3 lo, hi;
+  if (!bvhBounds(nodes, lo, hi)) return 0.0;
+  const double rootArea = halfArea(lo, hi);
+  const bool rootOk = rootArea > 0.0 && std::isfinite(rootArea);
+  auto rel = [&](const glm::vec3& a, const glm::vec3& b) { return rootOk ? halfArea(a, b) / rootArea : 1.0; };
+  const gpu::BvhNode& r = nodes[0];
+  if (r.right == gpu::kBvhEmptyRef)  // one leaf (or none): no inner node to pay for
+    return (r.left & gpu::kBvhLeafBit) ? costIntersect * double((r.left >> gpu::kBvhCountShift) & 15u) : 0.0;
+  double cost = costTraversal * 1.0;  // the root
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const gpu::BvhNode& node = nodes.at(stack.back());
+    stack.pop_back();
+    const std::uint32_t refs[2] = {node.left, node.right};
+    const glm::vec3 los[2] = {node.lmin, node.rmin}, his[2] = {node.lmax, node.rmax};
+    for (int k = 0; k < 2; ++k) {
+      if (refs[k] & gpu::kBvhLeafBit) {
+        cost += costIntersect * double((refs[k] >> gpu::kBvhCountShift) & 15u) * rel(los[k], his[k]);
+      } else {
+        cost += costTraversal * rel(los[k], his[k]);
+        stack.push_back(refs[k]);
+      }
+    }
+  }
+  return cost;
 }
 
 std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh) {

@@ -19,18 +19,12 @@ struct BvhBuildOptions {
   int threads = 0;          // build threads; 0: one per hardware thread (meshes under 65,536 triangles use one)
 };
 
-// A node of the builder's binary tree (32 bytes): its own box and either two children (leftFirst,
-// leftFirst + 1) or, with triCount > 0, a leaf over triangles [leftFirst, leftFirst + triCount) in leaf order.
-struct BvhBinaryNode {
-  glm::vec3 bmin;                 // world-space AABB minimum
-  std::uint32_t leftFirst = 0;    // inner: index of the left child (right = left + 1); leaf: first triangle
-  glm::vec3 bmax;                 // world-space AABB maximum
-  std::uint32_t triCount = 0;     // 0 for an inner node
-};
-
 struct Bvh {
-  std::vector<BvhBinaryNode> binary; // the builder's tree; binary[0] is the root, children adjacent
-  std::vector<gpu::BvhNode> nodes;   // GPU layout: one node per inner node of `binary`; nodes[0] is the root
+  // GPU layout, written by the builder directly: one node per inner node of the binary tree, holding both
+  // children's boxes and refs (leaves packed into the ref); nodes[0] is the root; a node's inner children
+  // get consecutive slots when it is split, depth-first, left first (so children follow their parent).
+  // A one-leaf tree is a root with that leaf and an empty slot, an empty tree a root with two empty slots.
+  std::vector<gpu::BvhNode> nodes;
   std::vector<std::uint32_t> order;  // leaf order -> index into the input triangle array
   int depth = 0;                     // deepest level (root = 1); always < CAUSTICA_BVH_STACK
   int leafCount = 0;
@@ -38,16 +32,17 @@ struct Bvh {
 };
 
 // Builds over the triangles' positions. Degenerate (zero-area) triangles are kept; they never hit.
+// The result does not depend on BvhBuildOptions::threads (bit for bit).
 // Throws caustica::Error if the tree would be deeper than the GPU traversal stack allows.
 Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options = {});
 
-// The GPU nodes of a binary tree: each inner node becomes a gpu::BvhNode holding both children's boxes
-// and refs (leaves packed into the ref); a one-leaf tree gets a root with that leaf and an empty slot,
-// an empty tree a root with two empty slots. Inner nodes keep depth-first order (root first).
-std::vector<gpu::BvhNode> packBvhNodes(const std::vector<BvhBinaryNode>& binary);
-
 // World-space bounds of everything under the root (both children's boxes); false for an empty tree.
 bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3& hi);
+
+// SAH cost of a packed tree relative to the root's surface area (the root's area taken as 1 when it is 0
+// or not finite): costTraversal per inner node and costIntersect per triangle, each weighted by its
+// box's area. Equals Bvh::sahCost up to rounding (summed in another order).
+double bvhSahCost(const std::vector<gpu::BvhNode>& nodes, float costTraversal = 1.0f, float costIntersect = 1.0f);
 
 // Packs triangle positions in BVH leaf order (TriGeom.v0.w carries the material index bits).
 std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh);

@@ -88,7 +88,6 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   bvh_.nodes.clear();
   gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
   gpuScene_.nodes = std::move(nodes);
-  std::vector<BvhBinaryNode>().swap(bvh_.binary);  // the builder's tree: the GPU nodes were made from it
   load_.pack = since(t0);
 
   GpuScene& g = gpuScene_;
