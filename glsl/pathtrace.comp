@@ -142,14 +142,25 @@ bool pathBounce(inout PathState s) {
 #ifdef CAUSTICA_VOLUME
     s.beta *= exp(-s.sigma * hit.t);
 #endif
+#ifdef CAUSTICA_INSTANCED
+    InstanceXform xf = instanceXform(hit.inst);
+    TriGeom g;
+    vec3 sn0, sn1, sn2;
+    vec2 st0, st1, st2;
+    instanceHitTriangle(hit, xf, g, sn0, sn1, sn2, st0, st1, st2);  // instances.glsl: world space
+#else
     TriGeom g = triGeomAt(hit.tri);
     vec3 sn0, sn1, sn2;
     vec2 st0, st1, st2;
     triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
     triUvs(hit.tri, st0, st1, st2);
+#endif
     float b0 = 1.0 - hit.u - hit.v;
     vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
     vec3 pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);  // spawn.glsl
+#ifdef CAUSTICA_INSTANCED
+    pError += instancePointError(g, xf);
+#endif
     vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
     float crLen = length(cr);
     if (!(crLen > 0.0)) return false;
@@ -175,7 +186,11 @@ bool pathBounce(inout PathState s) {
 #endif
 #ifdef CAUSTICA_MIS
       if (!s.prevDelta) {
+#ifdef CAUSTICA_INSTANCED
+        float pdfLight = instanceLightPdfArea(g, xf, s.prevP, s.prevN) * hit.t * hit.t / max(abs(dot(ngFront, s.dir)), 1.0e-12);
+#else
         float pdfLight = lightPdfArea(hit.tri, s.prevP, s.prevN) * hit.t * hit.t / max(abs(dot(ngFront, s.dir)), 1.0e-12);
+#endif
         w *= powerHeuristic(s.prevPdf, pdfLight);
       }
 #endif

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "accel/tlas.h"
 #include "scene/caustic_casters.h"
 #include "util/error.h"
 #include "shading/microfacet.h"
@@ -163,16 +164,10 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
   }
 }
 
-GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
-  GpuScene g;
-  g.features = sceneFeatures(scene);
-  g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
-  g.emitterSphere = emitterBoundingSphere(scene);
-  packEnvironment(scene, g);
-  g.nodes = bvh.nodes;
-  g.triangleCount = bvh.order.size();
-  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
-
+namespace {
+// What packScene and packInstancedScene share: features, environment, materials, punctual lights,
+// textures (not the triangles, the casters or the emitters).
+void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
   for (const Material& m : scene.materials) {
     gpu::Material gm{};
     gm.baseColor = m.baseColor;
@@ -227,6 +222,20 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
     g.texInfo.push_back(info);
   }
 
+}
+}  // namespace
+
+GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
+  GpuScene g;
+  g.features = sceneFeatures(scene);
+  g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
+  g.emitterSphere = emitterBoundingSphere(scene);
+  packEnvironment(scene, g);
+  g.nodes = bvh.nodes;
+  g.triangleCount = bvh.order.size();
+  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  packMaterialsAndTextures(scene, g);
+
   // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
   std::vector<double> weights;
   std::vector<std::uint32_t> tris;
@@ -262,6 +271,136 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   return g;
 }
 
+GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
+  if (bvh.triSource.size() != bvh.tris.size()) throw Error("internal: packInstancedScene without triSource");
+  GpuScene g;
+  g.features = sceneFeatures(scene);
+  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
+  // the light-leaf table).
+  std::vector<std::uint32_t> emissiveIndex(scene.triangles.size(), gpu::kInvalidIndex);
+  std::vector<std::uint32_t> meshEmitters(scene.meshes.size(), 0);
+  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const MeshRange& r = scene.meshes[mi];
+    for (std::uint32_t i = r.firstTriangle; i < r.firstTriangle + r.triangleCount; ++i)
+      if (scene.materials[scene.triangles[i].material].isEmissive()) emissiveIndex[i] = meshEmitters[mi]++;
+  }
+  // The emissive and specular (caster) triangles of every instance are flattened on the host
+  // (transiently), bounded so that many placed emitters or glass objects cannot exhaust the host.
+  // Casters only speed up caustics: skipped beyond the bound.
+  std::vector<bool> emissive(scene.materials.size()), specular(scene.materials.size());
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    emissive[m] = scene.materials[m].isEmissive();
+    specular[m] = scene.materials[m].metallic > 0.0f || scene.materials[m].transmission > 0.0f;
+  }
+  constexpr std::uint64_t kMaxFlattened = 1u << 22;
+  if (placedTriangles(scene, specular) <= kMaxFlattened)
+    g.casters = findCausticCasters(flattenedSubset(scene, specular), CAUSTICA_MAX_CASTERS);
+  if (placedTriangles(scene, emissive) > kMaxFlattened)
+    throw Error(scene.path + ": the instances place " + std::to_string(placedTriangles(scene, emissive)) +
+                " emissive triangles; the light tree takes at most " + std::to_string(kMaxFlattened) +
+                " of an instanced scene (load it with --instances off)");
+  std::vector<InstancedTriangle> source;
+  const Scene lights = flattenedSubset(scene, emissive, &source);
+  g.emitterSphere = emitterBoundingSphere(lights);
+  packEnvironment(scene, g);
+  packMaterialsAndTextures(scene, g);
+
+  // Stored triangles: object-space TriGeom (bvh.tris) and TriShade words, in bvh.tris order.
+  g.triangleCount = bvh.tris.size();
+  g.triGeom = std::move(bvh.tris);
+  g.triShade.resize(g.triangleCount * g.triShadeStride);
+  std::vector<std::uint32_t> storedIndex(scene.triangles.size(), gpu::kInvalidIndex);
+  for (std::size_t x = 0; x < g.triangleCount; ++x) {
+    const std::uint32_t i = bvh.triSource[x];
+    storedIndex[i] = static_cast<std::uint32_t>(x);
+    const Triangle& t = scene.triangles[i];
+    g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
+    std::uint32_t* w = g.triShade.data() + x * g.triShadeStride;
+    for (int k = 0; k < 3; ++k) w[k] = octEncode(t.n[k]);
+    if (g.triShadeStride == gpu::kTriShadeWordsTextured)
+      for (int k = 0; k < 3; ++k) {
+        w[3 + 2 * k] = floatBits(t.uv[k].x);
+        w[4 + 2 * k] = floatBits(t.uv[k].y);
+      }
+  }
+
+  // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
+  std::vector<double> weights;
+  std::vector<std::uint32_t> items;
+  std::vector<LightTreeItem> lightItems;
+  double totalWeight = 0.0;
+  for (std::size_t e = 0; e < lights.triangles.size(); ++e) {
+    const Triangle& tri = lights.triangles[e];
+    const Material& m = scene.materials[tri.material];
+    if (!m.isEmissive()) continue;
+    const glm::vec3* t = tri.p;
+    double area = 0.5 * glm::length(glm::cross(t[1] - t[0], t[2] - t[0]));
+    double w = static_cast<double>(luminance(glm::max(m.emission, glm::vec3(0.0f)))) * area * (m.doubleSided ? 2.0 : 1.0);
+    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    weights.push_back(w);
+    items.push_back(static_cast<std::uint32_t>(lightItems.size()));
+    totalWeight += w;
+    LightTreeItem item;
+    item.tri = storedIndex[source[e].triangle];
+    item.instance = source[e].instance;
+    for (int k = 0; k < 3; ++k) item.v[k] = t[k];
+    item.power = w;
+    item.twoSided = m.doubleSided;
+    lightItems.push_back(item);
+  }
+  g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
+  std::vector<std::uint32_t>().swap(g.lightTree.leafOf);  // per stored triangle: meaningless here
+  g.totalEmitterWeight = static_cast<float>(totalWeight);
+  g.totalPower = kPi * totalWeight;
+  g.emitters = buildAliasTable(weights, items);
+
+  // The light-leaf table: per instance of an emissive mesh, its emitters' leaves in emissiveIndex order.
+  std::vector<std::uint32_t> leafBase(scene.instances.size(), 0);
+  std::size_t tableSize = 0;
+  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+    leafBase[i] = static_cast<std::uint32_t>(tableSize);
+    tableSize += meshEmitters[scene.instances[i].mesh];
+  }
+  std::vector<std::uint32_t> table(tableSize, gpu::kInvalidIndex);
+  for (std::size_t n = 0; n < g.lightTree.nodes.size(); ++n) {
+    const glm::uvec4& link = g.lightTree.nodes[n].link;
+    if ((link.y & gpu::kLightNodeLeaf) == 0u) continue;
+    const std::uint32_t inst = link.y >> gpu::kLightNodeInstanceShift;
+    table[leafBase[inst] + emissiveIndex[bvh.triSource[link.x]]] = static_cast<std::uint32_t>(n);
+  }
+
+  // Nodes, then InstanceRecords (top-level leaf order), InstanceShades (Scene::instances order), the table.
+  g.nodes = std::move(bvh.nodes);
+  g.instanceCount = static_cast<std::uint32_t>(scene.instances.size());
+  g.instanceRecordBase = static_cast<std::uint32_t>(g.nodes.size());
+  const auto append = [&](const void* data, std::size_t bytes) {
+    const std::size_t first = g.nodes.size();
+    g.nodes.resize(first + (bytes + sizeof(gpu::BvhNode) - 1) / sizeof(gpu::BvhNode), gpu::BvhNode{});
+    if (bytes) std::memcpy(static_cast<void*>(g.nodes.data() + first), data, bytes);
+  };
+  append(bvh.instances.data(), bvh.instances.size() * sizeof(gpu::InstanceRecord));
+  std::vector<gpu::InstanceShade> shades(scene.instances.size());
+  glm::dmat4 rebase0(1.0);
+  rebase0[3] = glm::dvec4(-scene.origin, 1.0);
+  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& in = scene.instances[i];
+    const glm::dmat4 w = rebase0 * in.world;
+    gpu::InstanceShade& sh = shades[i];
+    sh.row0 = glm::vec4(w[0][0], w[1][0], w[2][0], w[3][0]);
+    sh.row1 = glm::vec4(w[0][1], w[1][1], w[2][1], w[3][1]);
+    sh.row2 = glm::vec4(w[0][2], w[1][2], w[2][2], w[3][2]);
+    sh.lightLeafBase = leafBase[i];
+    sh.flags = glm::determinant(glm::dmat3(in.world)) < 0.0 ? gpu::kInstanceMirrored : 0u;
+    g.instancedTriangles += scene.meshes[in.mesh].triangleCount;
+  }
+  append(shades.data(), shades.size() * sizeof(gpu::InstanceShade));
+  g.lightLeafTableTexel = static_cast<std::uint32_t>(g.nodes.size() * (sizeof(gpu::BvhNode) / 16));
+  append(table.data(), table.size() * sizeof(std::uint32_t));
+  std::vector<gpu::InstanceRecord>().swap(bvh.instances);
+  return g;
+}
+
 glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k) {
   return octDecode(g.triShade[tri * g.triShadeStride + static_cast<std::size_t>(k)]);
 }
@@ -270,6 +409,13 @@ glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k) {
   if (g.triShadeStride != gpu::kTriShadeWordsTextured) return glm::vec2(0.0f);
   const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + 3 + 2 * k;
   return glm::vec2(glm::uintBitsToFloat(w[0]), glm::uintBitsToFloat(w[1]));
+}
+
+std::vector<std::string> GpuScene::instanceDefines() const {
+  if (instanceCount == 0) return {};
+  return {"CAUSTICA_INSTANCED", "CAUSTICA_INSTANCE_RECORD_BASE=" + std::to_string(instanceRecordBase) + "u",
+          "CAUSTICA_INSTANCE_COUNT=" + std::to_string(instanceCount) + "u",
+          "CAUSTICA_LIGHT_LEAF_TABLE=" + std::to_string(lightLeafTableTexel) + "u"};
 }
 
 GpuSceneBytes gpuSceneBytes(const GpuScene& g) {

@@ -48,11 +48,25 @@ struct GpuScene {
   // The environment map and its sampling CDFs (width 0: no environment light).
   EnvironmentDistribution environment;
   gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
+  // Instanced scenes (packInstancedScene; instanceCount 0: a flat scene). `nodes` then holds the
+  // two-level BVH's nodes, instanceCount InstanceRecords from node instanceRecordBase, instanceCount
+  // InstanceShades, and the light-leaf table from texel lightLeafTableTexel (gpu_layout.h); TriGeom and
+  // TriShade hold the meshes' stored triangles in object space.
+  std::uint32_t instanceCount = 0, instanceRecordBase = 0, lightLeafTableTexel = 0;
+  std::uint64_t instancedTriangles = 0;  // the triangles of every instance together (what flattening makes)
+  // CAUSTICA_INSTANCED and its layout constants (none for a flat scene).
+  std::vector<std::string> instanceDefines() const;
 };
 
 // `triangleArrays` false leaves triGeom and triShade empty: the Renderer packs and uploads them in
 // slices (packTriangleRange), so the host never holds them whole.
 GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays = true);
+struct InstancedBvh;
+// An instanced scene (Scene::instances not empty) and its two-level BVH (tlas.h, moved from: its
+// nodes, tris and instances end up in the result). Emitters are every instance's emissive triangles
+// (the light tree's leaves carry the instance); casters and the emitter sphere come from the world-space
+// copies of only the meshes that hold specular or emissive triangles (flattenedSubset).
+GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh);
 // TriGeom records and TriShade words of triangles [first, first + count) (BVH leaf order) of a scene
 // packed by packScene (it needs g.lightTree.leafOf and g.triShadeStride), into geom and shade.
 void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, std::size_t first, std::size_t count,

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "util/error.h"
+
 namespace caustica {
 namespace {
 
@@ -87,6 +89,7 @@ struct Item {
   Bounds b;
   glm::dvec3 centroid;
   std::uint32_t tri;
+  std::uint32_t instance;  // LightTreeItem::instance
 };
 
 class Builder {
@@ -104,7 +107,7 @@ class Builder {
     node.link = glm::uvec4(0u, b.twoSided ? gpu::kLightNodeTwoSided : 0u, 0u, 0u);
     if (end - begin == 1) {
       node.link.x = items[begin].tri;
-      node.link.y |= gpu::kLightNodeLeaf;
+      node.link.y |= gpu::kLightNodeLeaf | items[begin].instance << gpu::kLightNodeInstanceShift;
       node.link.z = trail;
       node.link.w = static_cast<std::uint32_t>(depth);
       tree_.leafOf[items[begin].tri] = nodeIndex;
@@ -211,6 +214,9 @@ LightTree buildLightTree(std::vector<LightTreeItem> in, std::size_t triangleCoun
     it.b.twoSided = t.twoSided;
     it.centroid = (it.b.lo + it.b.hi) * 0.5;
     it.tri = t.tri;
+    it.instance = t.instance;
+    if (t.instance >= (1u << (32 - gpu::kLightNodeInstanceShift)))
+      throw Error("light_tree.cpp: more than 2^30 instances");
     items.push_back(it);
   }
   tree.nodes.reserve(2 * items.size());

@@ -17,6 +17,7 @@ struct LightTreeItem {
   glm::vec3 v[3];         // vertices; the front face is counter-clockwise, normal cross(v1 - v0, v2 - v0)
   double power = 0.0;     // luminance(emission) * area * sides (> 0)
   bool twoSided = false;  // emits from both faces
+  std::uint32_t instance = 0;  // instanced scenes: Scene::instances index, kept in the leaf's link.y (< 2^30)
 };
 
 struct LightTree {

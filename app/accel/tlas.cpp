@@ -1,4 +1,4 @@
-// tlas.cpp — instancing's two-level BVH and its C++ traversal (tlas.h, docs/instancing-status.md).
+// tlas.cpp — instancing's two-level BVH and its C++ traversal (tlas.h, docs/instancing.md).
 #include "accel/tlas.h"
 
 #include <algorithm>

@@ -1,7 +1,7 @@
-// tlas.h — instancing's two-level BVH (docs/instancing-status.md): one bottom-level BVH per mesh of
+// tlas.h — instancing's two-level BVH (docs/instancing.md): one bottom-level BVH per mesh of
 // an instanced scene (Scene::meshes, object space, the ordinary builder), a top-level BVH over the
 // instances' world boxes, and the C++ traversal that moves the ray into an instance's object space at
-// a top-level leaf and back. Host side only so far: the GLSL twin and the renderer are the next step.
+// a top-level leaf and back; its GLSL twin is glsl/lib/traverse_instanced.glsl.
 #pragma once
 #include <cstdint>
 #include <limits>
@@ -34,7 +34,7 @@ struct InstancedHit {
   std::uint32_t instance = gpu::kInvalidIndex;     // Scene::instances index
 };
 
-// Closest hit with t in (0, tmax): twin-to-be of the GLSL traversal.
+// Closest hit with t in (0, tmax): twin of traceInstanced (glsl/lib/traverse_instanced.glsl).
 InstancedHit traceClosest(const InstancedBvh& bvh, const Ray& ray, float tmax = std::numeric_limits<float>::infinity());
 // Any hit with t in (0, tmax).
 bool traceOccluded(const InstancedBvh& bvh, const Ray& ray, float tmax);

@@ -155,6 +155,9 @@ std::vector<OptionSpec> sceneInputOptionSpecs() {
            std::to_string(defaults.maxBufferBytes >> 20) + ")"},
       {"--max-triangles", "", "N",
        "refuse scenes with more than N triangles (default " + std::to_string(defaults.maxTriangles) + ")"},
+      {"--instances", "", "auto|on|off",
+       "keep meshes placed several times once on the GPU (two-level BVH): on, off (flatten them), or auto "
+       "(default): on when the placed triangles exceed --max-triangles or 4x the stored ones"},
   };
 }
 
@@ -164,6 +167,11 @@ LoadOptions loadOptionsFrom(const Options& opts) {
   o.maxTextureBytes = std::uint64_t(opts.getInt("--max-texture-mib", int(o.maxTextureBytes >> 20), 1, 1 << 20)) << 20;
   o.maxBufferBytes = std::uint64_t(opts.getInt("--max-buffer-mib", int(o.maxBufferBytes >> 20), 1, 1 << 20)) << 20;
   o.maxTriangles = std::uint64_t(opts.getInt("--max-triangles", int(o.maxTriangles), 1, 1 << 30));
+  const std::string instances = opts.get("--instances", "auto");
+  if (instances != "auto" && instances != "on" && instances != "off")
+    throw Error("option --instances expects auto, on or off, got '" + instances + "'");
+  o.keepInstances = instances != "off";
+  o.autoInstances = instances == "auto";
   return o;
 }
 
@@ -309,6 +317,20 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
     ls.camera = ls.scene.cameras[static_cast<size_t>(index)];
   }
   return ls;
+}
+
+void flattenForRaster(Scene& scene, const Options& opts, bool quiet) {
+  if (scene.instances.empty()) return;
+  std::uint64_t placed = 0;
+  for (const Instance& in : scene.instances) placed += scene.meshes[in.mesh].triangleCount;
+  const std::uint64_t limit = loadOptionsFrom(opts).maxTriangles;
+  if (placed > limit)
+    throw Error(scene.path + ": the raster mode draws flattened scenes, and flattening its " +
+                std::to_string(scene.instances.size()) + " instances makes " + std::to_string(placed) +
+                " triangles, more than the limit of " + std::to_string(limit) + " (use --max-triangles to raise it)");
+  note(quiet, "raster mode: " + std::to_string(scene.instances.size()) + " instances flattened into " +
+                  std::to_string(placed) + " triangles");
+  flattenInstances(scene);
 }
 
 LoadedScene loadSceneForCli(const Options& opts, bool verbose) {

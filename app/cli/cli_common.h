@@ -52,7 +52,7 @@ OptionSpec sceneOptionSpec(const std::string& name);
 // Options of every command that loads a scene (render, view, bench, info): how far an untrusted
 // scene file is trusted (docs/untrusted-input.md). Part of sceneOptionSpecs().
 std::vector<OptionSpec> sceneInputOptionSpecs();
-// --allow-outside-paths, --max-texture-mib, --max-buffer-mib and --max-triangles as LoadOptions
+// --allow-outside-paths, --max-texture-mib, --max-buffer-mib, --max-triangles and --instances as LoadOptions
 // (defaults: LoadOptions{}); each bad value is an error naming the option.
 LoadOptions loadOptionsFrom(const Options& opts);
 
@@ -69,6 +69,9 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
 // The same for the command's one positional scene argument (default: the bundled default scene).
 LoadedScene loadSceneForCli(const Options& opts, bool verbose);
 int cameraIndexFrom(const Options& opts);  // --camera N, default 0
+// The raster mode draws flat scenes only: bakes an instanced scene's instances on the host
+// (flattenInstances), or refuses (Error) when that would exceed --max-triangles.
+void flattenForRaster(Scene& scene, const Options& opts, bool quiet);
 
 // The one place the command line becomes RenderSettings (render, view and bench): --size (default
 // `defaultWidth`, height from the camera's aspect), --seed, --max-depth, --integrator, --dispersion,

@@ -47,6 +47,7 @@ int cmdCompare(const std::vector<std::string>& args) {
   checkWritableFile(out, "output");
 
   LoadedScene ls = loadSceneForCli(opts, !quiet);
+  flattenForRaster(ls.scene, opts, quiet);  // one scene for the three modes; raster draws flat ones
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 384);
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);

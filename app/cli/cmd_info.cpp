@@ -11,6 +11,7 @@
 #include "accel/bvh.h"
 #include "util/error.h"
 #include "accel/gpu_scene.h"
+#include "accel/tlas.h"
 #include "shading/microfacet.h"
 
 namespace caustica::cli {
@@ -52,14 +53,21 @@ int cmdInfo(const std::vector<std::string>& args) {
   const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   t0 = std::chrono::steady_clock::now();
-  Bvh bvh = buildBvh(s.triangles);
+  const bool instanced = !s.instances.empty();  // --instances (docs/big-scenes.md)
+  Bvh bvh;
+  InstancedBvh ibvh;
+  if (instanced) ibvh = buildInstancedBvh(s);
+  else bvh = buildBvh(s.triangles);
   double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::size_t topNodes = ibvh.topNodeCount, allNodes = ibvh.nodes.size();
   t0 = std::chrono::steady_clock::now();
-  GpuScene g = packScene(s, bvh);
+  GpuScene g = instanced ? packInstancedScene(s, ibvh) : packScene(s, bvh);
   const double packSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   std::printf("scene:      %s\n", s.path.c_str());
   std::printf("triangles:  %zu\n", s.triangles.size());
+  std::printf("instances:  %s\n", instanced ? (instancesSummary(g) + " of " + std::to_string(s.meshes.size()) + " meshes").c_str()
+                                            : instancesSummary(g).c_str());
   std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitters.size(),
               g.totalPower);
   std::printf("lighting:   %s\n", lightingSummary(s, g.emitters.size()).c_str());
@@ -94,8 +102,13 @@ int cmdInfo(const std::vector<std::string>& args) {
               s.cameras.empty() ? "automatic" : ("'" + c.name + "'").c_str(), vec(c.position).c_str(),
               vec(c.forward).c_str(), c.yfov * 57.29578f, c.aspect > 0 ? (", aspect " + std::to_string(c.aspect)).c_str() : "",
               s.cameras.size());
-  std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
-              bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
+  if (instanced)
+    std::printf("bvh:        two-level, %zu top-level + %zu mesh nodes, %u instance records (%zu KiB with the records), "
+                "depth %d, built in %.1f ms\n", topNodes, allNodes - topNodes, g.instanceCount,
+                g.nodes.size() * sizeof(gpu::BvhNode) / 1024, ibvh.depth, buildSeconds * 1e3);
+  else
+    std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
+                bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
   std::printf("memory:     %s; %s\n", gpuBytesSummary(gpuSceneBytes(g), s.triangles.size()).c_str(),
               hostPeakSummary(s.triangles.size()).c_str());
   std::printf("load:       parse %.2f s, BVH %.2f s, pack %.2f s (upload and first sample: render's load line)\n",

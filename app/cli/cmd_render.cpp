@@ -81,6 +81,7 @@ int cmdRender(const std::vector<std::string>& args) {
   if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
+  if (settings.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, quiet);  // cli_common.h
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
   if (opts.has("--light-radius")) settingsText += "light-radius " + opts.get("--light-radius", "") + "\n";  // changes the scene

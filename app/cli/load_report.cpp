@@ -30,6 +30,15 @@ std::string hostPeakSummary(std::size_t n) {
   return line;
 }
 
+std::string instancesSummary(const GpuScene& g) {
+  if (g.instanceCount == 0) return "no instances (flat)";
+  char line[160];
+  std::snprintf(line, sizeof line, "%u instances: %zu stored triangles, %llu instanced (%.1fx)", g.instanceCount,
+                g.triangleCount, static_cast<unsigned long long>(g.instancedTriangles),
+                g.triangleCount ? double(g.instancedTriangles) / double(g.triangleCount) : 0.0);
+  return line;
+}
+
 std::string loadSummary(const Renderer& r, double parseSeconds, double startToRenderer, std::size_t n) {
   const LoadTimes& t = r.loadTimes();
   char line[256];
@@ -38,7 +47,9 @@ std::string loadSummary(const Renderer& r, double parseSeconds, double startToRe
                 "after start (first pass done at %.2f s); ",
                 parseSeconds, t.bvh, t.pack, t.upload, t.compile, startToRenderer + t.ready,
                 t.firstPass > 0.0 ? startToRenderer + t.firstPass : 0.0);
-  return line + hostPeakSummary(n) + "; " + gpuBytesSummary(r.gpuBytes(), n) + "; " + r.bufferLayout().describe();
+  std::string out = line + hostPeakSummary(n) + "; " + gpuBytesSummary(r.gpuBytes(), n) + "; " + r.bufferLayout().describe();
+  if (r.gpuScene().instanceCount > 0) out += "; " + instancesSummary(r.gpuScene());
+  return out;
 }
 
 }  // namespace caustica::cli

@@ -17,8 +17,10 @@ namespace caustica::cli {
 std::string gpuBytesSummary(const GpuSceneBytes& bytes, std::size_t triangles);
 // "host peak 240.1 MiB, 240 B/triangle" (VmHWM so far; on llvmpipe GPU buffers are host memory too)
 std::string hostPeakSummary(std::size_t triangles);
+// "66 instances: 1000000 stored triangles, 64100000 instanced (64.1x)", or "no instances (flat)".
+std::string instancesSummary(const GpuScene& g);
 // "load: parse 1.20 s, BVH 0.50 s, pack 0.20 s, upload 0.10 s, shaders 0.30 s; first sample starts 2.40 s
-// after start (first pass done at 2.90 s); host peak ...; GPU ...; one block per array". `parseSeconds`: reading the scene;
+// after start (first pass done at 2.90 s); host peak ...; GPU ...; one block per array[; instancesSummary]". `parseSeconds`: reading the scene;
 // `startToRenderer`: seconds from the command's start to the Renderer's construction.
 std::string loadSummary(const Renderer& renderer, double parseSeconds, double startToRenderer, std::size_t triangles);
 

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "accel/tlas.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
 
@@ -72,22 +73,27 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     throw Error("this GPU's compute work groups are too small");
   settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
-  if (!scene.instances.empty())  // docs/instancing-status.md: the GPU path is not there yet
-    throw Error((scene.path.empty() ? std::string("scene") : scene.path) +
-                ": instanced scenes (LoadOptions::keepInstances) are not rendered yet; flattenInstances first");
-
   created_ = std::chrono::steady_clock::now();
   const auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
   auto t0 = std::chrono::steady_clock::now();
-  bvh_ = buildBvh(scene.triangles);
-  bvhSeconds_ = load_.bvh = since(t0);
-  t0 = std::chrono::steady_clock::now();
-  std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
-  bvh_.nodes.clear();
-  gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
-  gpuScene_.nodes = std::move(nodes);
+  const bool instanced = !scene.instances.empty();
+  if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
+    InstancedBvh ib = buildInstancedBvh(scene);
+    bvhSeconds_ = load_.bvh = since(t0);
+    bvh_.depth = ib.depth;
+    t0 = std::chrono::steady_clock::now();
+    gpuScene_ = packInstancedScene(scene, ib);
+  } else {
+    bvh_ = buildBvh(scene.triangles);
+    bvhSeconds_ = load_.bvh = since(t0);
+    t0 = std::chrono::steady_clock::now();
+    std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
+    bvh_.nodes.clear();
+    gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
+    gpuScene_.nodes = std::move(nodes);
+  }
   load_.pack = since(t0);
 
   GpuScene& g = gpuScene_;
@@ -110,7 +116,13 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
   punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
   uploadCasters();
-  lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
+  if (instanced) {  // the point lights of Whitted and raster: from world-space copies of the emissive meshes
+    std::vector<bool> emissive(scene.materials.size());
+    for (std::size_t m = 0; m < scene.materials.size(); ++m) emissive[m] = scene.materials[m].isEmissive();
+    lightGroups_ = groupEmitters(flattenedSubset(scene, emissive), CAUSTICA_MAX_POINT_LIGHTS);
+  } else {
+    lightGroups_ = groupEmitters(scene, CAUSTICA_MAX_POINT_LIGHTS);
+  }
   pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
   environment_.upload(g, limits_, scene.path);
@@ -128,6 +140,8 @@ void Renderer::prepareMode() {
   if (settings_.mode != RenderMode::Raster) {
     program();
   } else if (!raster_) {
+    if (gpuScene_.instanceCount > 0)
+      throw Error("raster mode draws flattened scenes only: load this scene with --instances off");
     downloadSceneArrays(gpuScene_, bufferLayout_, buffers_);  // the raster mesh is built from them
     raster_ = std::make_unique<RasterRenderer>(library_, gpuScene_, pointLights_);
     std::vector<gpu::TriGeom>().swap(gpuScene_.triGeom);
@@ -151,6 +165,7 @@ std::vector<std::string> Renderer::shaderDefines() const {
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
+  for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
   if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {

@@ -147,6 +147,10 @@ class SceneBuilder {
   // Refuses a scene whose mesh instances declare more than options_.maxTriangles triangles (from
   // accessor counts), before any accessor is decoded.
   void checkTriangleCount();  // also reserves the triangles
+  // Triangles mesh `mesh`'s primitives declare (accessor counts; 0 for a bad index).
+  std::uint64_t declaredTriangles(int mesh) const;
+  // LoadOptions::autoInstances: whether keeping the instances pays, from the declared counts.
+  bool instancingPays() const;
   // The world-space point (scene units, double) that becomes the float origin: for a scene farther
   // from the world origin than its size, the centre of the meshes' bounds from their POSITION
   // accessors' min/max (node origins where those are missing); else 0.
@@ -182,7 +186,7 @@ class SceneBuilder {
   const std::string& path_;
   const tinygltf::Model& model_;
   const ImageLog& images_;
-  const LoadOptions& options_;
+  LoadOptions options_;  // a copy: autoInstances settles keepInstances in build()
   Scene& scene_;
   std::map<int, int> textureMap_;  // glTF texture index -> Scene::textures index (-1: ignored)
   // Transformed references (KHR_texture_transform): glTF texture index and rows -> Scene::textures index.

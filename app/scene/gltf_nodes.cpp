@@ -23,6 +23,7 @@ void SceneBuilder::build() {
   warnUnsupportedExtensions();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
   traverse();
+  if (options_.keepInstances && options_.autoInstances) options_.keepInstances = instancingPays();
   checkTriangleCount();
   // Positions become float relative to the scene's centre, computed in double, so a scene far from
   // the world origin keeps the precision of one near it (docs/stability.md).
@@ -64,6 +65,43 @@ void SceneBuilder::warnUnsupportedExtensions() {
   if (!list.empty()) warn("ignoring unsupported extension(s): " + list);
 }
 
+namespace {
+// Triangles a primitive declares (accessor counts; 0 for other modes or bad indices, reported later).
+std::uint64_t primitiveTriangles(const tinygltf::Model& model, const tinygltf::Primitive& prim) {
+  if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    return 0;
+  int source = prim.indices;
+  if (source < 0) {
+    const auto pos = prim.attributes.find("POSITION");
+    if (pos == prim.attributes.end()) return 0;
+    source = pos->second;
+  }
+  if (source < 0 || std::size_t(source) >= model.accessors.size()) return 0;  // readAccessor reports it
+  const std::uint64_t n = model.accessors[std::size_t(source)].count;
+  return prim.mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : (n >= 3 ? n - 2 : 0);
+}
+}  // namespace
+
+std::uint64_t SceneBuilder::declaredTriangles(int mesh) const {
+  if (mesh < 0 || std::size_t(mesh) >= model_.meshes.size()) return 0;
+  std::uint64_t total = 0;
+  for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(mesh)].primitives)
+    total = std::min(std::uint64_t(1) << 62, total + std::min(std::uint64_t(1) << 62, primitiveTriangles(model_, prim)));
+  return total;
+}
+
+bool SceneBuilder::instancingPays() const {
+  std::uint64_t stored = 0, placed = 0;
+  std::set<int> seen;
+  for (const MeshInstance& m : meshInstances_) {
+    const std::uint64_t n = declaredTriangles(m.mesh);
+    placed = std::min(std::uint64_t(1) << 62, placed + n);
+    if (seen.insert(m.mesh).second) stored += n;
+  }
+  return placed > options_.maxTriangles || double(placed) > options_.autoInstanceFactor * double(stored);
+}
+
 void SceneBuilder::checkTriangleCount() {
   // Saturating sums: a hostile file may declare counts near 2^53 on many instances.
   const std::uint64_t kSaturated = std::numeric_limits<std::uint64_t>::max() / 2;
@@ -76,18 +114,7 @@ void SceneBuilder::checkTriangleCount() {
     if (m.mesh < 0 || std::size_t(m.mesh) >= model_.meshes.size()) continue;  // addMesh reports it
     if (options_.keepInstances && !counted.insert(m.mesh).second) continue;
     for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(m.mesh)].primitives) {
-      if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-          prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
-        continue;
-      int source = prim.indices;
-      if (source < 0) {
-        const auto pos = prim.attributes.find("POSITION");
-        if (pos == prim.attributes.end()) continue;
-        source = pos->second;
-      }
-      if (source < 0 || std::size_t(source) >= model_.accessors.size()) continue;  // readAccessor reports it
-      const std::uint64_t n = model_.accessors[std::size_t(source)].count;
-      const std::uint64_t triangles = prim.mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : (n >= 3 ? n - 2 : 0);
+      const std::uint64_t triangles = primitiveTriangles(model_, prim);
       total = std::min(kSaturated, total + std::min(kSaturated, triangles));
       if (total > options_.maxTriangles)
         fail(m.at + " (meshes[" + str(std::uint64_t(m.mesh)) + "]) brings the scene's declared triangles to " +

@@ -1,5 +1,5 @@
 // instances.cpp — flattenInstances: an instanced scene (LoadOptions::keepInstances) baked into the
-// world-space triangles the loader makes without it (docs/instancing-status.md).
+// world-space triangles the loader makes without it (docs/instancing.md).
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -10,40 +10,88 @@
 
 namespace caustica {
 
+namespace {
+// Appends instance `in`'s world-space triangles (zero-area ones dropped; with `materialWanted`, only
+// those of the wanted materials) to `out`, and to `source` (when given) the Scene::triangles index each
+// came from.
+void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangle>& out,
+                     std::vector<std::uint32_t>* source, const std::vector<bool>* materialWanted = nullptr) {
+  const MeshRange& m = scene.meshes[in.mesh];
+  const glm::dmat3 m3(in.world);
+  const glm::dmat3 normal = glm::transpose(glm::inverse(m3));
+  const bool flip = glm::determinant(m3) < 0.0;  // as the loader: restore counter-clockwise fronts
+  for (std::uint32_t i = m.firstTriangle; i < m.firstTriangle + m.triangleCount; ++i) {
+    const Triangle& src = scene.triangles[i];
+    if (materialWanted && (src.material >= materialWanted->size() || !(*materialWanted)[src.material])) continue;
+    Triangle t;
+    t.material = src.material;
+    for (int k = 0; k < 3; ++k) {
+      const int s = flip && k > 0 ? 3 - k : k;  // swaps corners 1 and 2
+      t.p[k] = glm::vec3(glm::dvec3(in.world * glm::dvec4(glm::dvec3(src.p[s]), 1.0)) - scene.origin);
+      const glm::dvec3 n = normal * glm::dvec3(src.n[s]);
+      const double len = glm::length(n);
+      t.n[k] = len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0.0f);
+      t.uv[k] = src.uv[s];
+    }
+    const glm::vec3 cross = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+    const float area2 = glm::length(cross);
+    if (!(area2 > 0.0f) || !std::isfinite(area2)) continue;  // zero area in world space
+    if (t.n[0] == glm::vec3(0.0f) || t.n[1] == glm::vec3(0.0f) || t.n[2] == glm::vec3(0.0f))
+      t.n[0] = t.n[1] = t.n[2] = cross / area2;
+    out.push_back(t);
+    if (source) source->push_back(i);
+  }
+}
+}  // namespace
+
 void flattenInstances(Scene& scene) {
   if (scene.instances.empty()) return;
   std::vector<Triangle> out;
   std::size_t total = 0;
   for (const Instance& in : scene.instances) total += scene.meshes[in.mesh].triangleCount;
   out.reserve(total);
-  for (const Instance& in : scene.instances) {
-    const MeshRange& m = scene.meshes[in.mesh];
-    const glm::dmat3 m3(in.world);
-    const glm::dmat3 normal = glm::transpose(glm::inverse(m3));
-    const bool flip = glm::determinant(m3) < 0.0;  // as the loader: restore counter-clockwise fronts
-    for (std::uint32_t i = m.firstTriangle; i < m.firstTriangle + m.triangleCount; ++i) {
-      const Triangle& src = scene.triangles[i];
-      Triangle t;
-      t.material = src.material;
-      for (int k = 0; k < 3; ++k) {
-        const int s = flip && k > 0 ? 3 - k : k;  // swaps corners 1 and 2
-        t.p[k] = glm::vec3(glm::dvec3(in.world * glm::dvec4(glm::dvec3(src.p[s]), 1.0)) - scene.origin);
-        const glm::dvec3 n = normal * glm::dvec3(src.n[s]);
-        const double len = glm::length(n);
-        t.n[k] = len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0.0f);
-        t.uv[k] = src.uv[s];
-      }
-      const glm::vec3 cross = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-      const float area2 = glm::length(cross);
-      if (!(area2 > 0.0f) || !std::isfinite(area2)) continue;  // zero area in world space
-      if (t.n[0] == glm::vec3(0.0f) || t.n[1] == glm::vec3(0.0f) || t.n[2] == glm::vec3(0.0f))
-        t.n[0] = t.n[1] = t.n[2] = cross / area2;
-      out.push_back(t);
-    }
-  }
+  for (const Instance& in : scene.instances) flattenInstance(scene, in, out, nullptr);
   scene.triangles = std::move(out);
   scene.meshes.clear();
   scene.instances.clear();
+}
+
+std::vector<std::uint64_t> wantedPerMesh(const Scene& scene, const std::vector<bool>& materialWanted) {
+  std::vector<std::uint64_t> n(scene.meshes.size(), 0);
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+    for (std::uint32_t i = 0; i < scene.meshes[m].triangleCount; ++i) {
+      const std::uint32_t mat = scene.triangles[scene.meshes[m].firstTriangle + i].material;
+      if (mat < materialWanted.size() && materialWanted[mat]) ++n[m];
+    }
+  return n;
+}
+
+std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& materialWanted) {
+  const std::vector<std::uint64_t> perMesh = wantedPerMesh(scene, materialWanted);
+  std::uint64_t n = 0;
+  for (const Instance& in : scene.instances) n += perMesh[in.mesh];
+  return n;
+}
+
+Scene flattenedSubset(const Scene& scene, const std::vector<bool>& materialWanted, std::vector<InstancedTriangle>* source) {
+  Scene out;
+  out.path = scene.path;
+  out.materials = scene.materials;
+  out.punctualLights = scene.punctualLights;
+  out.spotEmitters = scene.spotEmitters;
+  out.bounds = scene.bounds;
+  out.origin = scene.origin;
+  const std::vector<std::uint64_t> perMesh = wantedPerMesh(scene, materialWanted);
+  std::vector<std::uint32_t> from;
+  for (std::uint32_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& in = scene.instances[i];
+    if (perMesh[in.mesh] == 0) continue;
+    from.clear();
+    flattenInstance(scene, in, out.triangles, &from, &materialWanted);
+    if (source)
+      for (std::uint32_t t : from) source->push_back({i, t});
+  }
+  return out;
 }
 
 }  // namespace caustica

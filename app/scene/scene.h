@@ -96,7 +96,7 @@ struct Bounds {
   bool empty() const { return min.x > max.x; }
 };
 
-// Instancing (docs/instancing-status.md). A mesh stored once, in its own (object) space:
+// Instancing (docs/instancing.md). A mesh stored once, in its own (object) space:
 // Scene::triangles[firstTriangle, firstTriangle + triangleCount), in the file's winding.
 struct MeshRange {
   std::uint32_t firstTriangle = 0;
@@ -158,12 +158,33 @@ struct LoadOptions {
   // as Scene::instances, instead of baking them into world-space copies. maxTriangles then bounds
   // the stored (object-space) triangles, not the instanced ones.
   bool keepInstances = false;
+  // With keepInstances: keep them only where that pays, decided from the accessors' declared counts
+  // before anything is decoded: when all instances together declare more than maxTriangles or more
+  // than autoInstanceFactor x the stored meshes' triangles. Otherwise the scene loads flattened, exactly
+  // as without keepInstances (`--instances auto`, docs/instancing.md).
+  bool autoInstances = false;
+  double autoInstanceFactor = 4.0;  // instanced traversal costs ~1.4x flattened (docs/instancing.md)
 };
 
 // Bakes an instanced scene (Scene::instances not empty) into world-space triangles, exactly as the
 // loader would have without keepInstances (same order, winding, normals; zero-area triangles
 // dropped), and empties meshes and instances. Does nothing to a scene without instances.
 void flattenInstances(Scene& scene);
+
+// Where a triangle of flattenedSubset came from.
+struct InstancedTriangle {
+  std::uint32_t instance = 0;  // Scene::instances index
+  std::uint32_t triangle = 0;  // Scene::triangles index (object space)
+};
+// The world-space triangles (as flattenInstances makes them) of every instance whose material has
+// materialWanted[material], in a scene with the materials, lights, bounds and origin but no textures:
+// what the host-side passes over emitters and specular objects (light groups, caustic casters, the
+// emitter sphere, the light tree) need from an instanced scene without flattening all of it. `source`,
+// when given, receives one InstancedTriangle per triangle.
+Scene flattenedSubset(const Scene& scene, const std::vector<bool>& materialWanted,
+                      std::vector<InstancedTriangle>* source = nullptr);
+// How many triangles flattenedSubset(scene, materialWanted) would make (zero-area ones included).
+std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& materialWanted);
 
 // Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const LoadOptions& options);

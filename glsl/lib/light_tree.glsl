@@ -46,6 +46,10 @@ float lightImportance(LightNode node, vec3 p, vec3 n) {
   return max(importance, 0.0);
 }
 
+#ifdef CAUSTICA_INSTANCED
+uint gLightInstance = 0u;  // instanced scenes: the Scene::instances index of the leaf sampleLightTree chose
+#endif
+
 // Descends from the root choosing each child in proportion to its importance, u in [0, 1) rescaled at
 // every level. False where no triangle can light p; else tri (TriGeom order) and pmf, its probability.
 bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
@@ -58,6 +62,9 @@ bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
     uvec4 link = lightNodes[i].link;
     if ((link.y & kLightNodeLeaf) != 0u) {
       tri = link.x;
+#ifdef CAUSTICA_INSTANCED
+      gLightInstance = link.y >> kLightNodeInstanceShift;
+#endif
       pmf = prob;
       return true;
     }

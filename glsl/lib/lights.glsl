@@ -23,6 +23,19 @@ float lightPdfArea(uint tri, vec3 p, vec3 n) {
   return area > 0.0 ? lightTreePdf(p, n, leaf - 1u) / area : 0.0;
 }
 
+#ifdef CAUSTICA_INSTANCED
+// The same for a hit on world-space triangle g (instanceTriangle) of instance x: its emitter number
+// (g.v1.w) leads through the instance's light-leaf table to its leaf.
+float instanceLightPdfArea(TriGeom g, InstanceXform x, vec3 p, vec3 n) {
+  uint k = floatBitsToUint(g.v1.w);  // emitter number within the mesh + 1; 0: not an emitter
+  if (k == 0u) return 0.0;
+  uint leaf = instanceLightLeaf(x, k - 1u);
+  if (leaf == kInvalidIndex) return 0.0;
+  float area = 0.5 * length(cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz));
+  return area > 0.0 ? lightTreePdf(p, n, leaf) / area : 0.0;
+}
+#endif
+
 // Samples a point on an emitter for shading point p with unit normal n (world space): uSelect descends
 // the light tree, uTri places the point uniformly on the chosen triangle.
 bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
@@ -30,10 +43,18 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   uint tri;
   float pmf;
   if (!sampleLightTree(p, n, uSelect, tri, pmf)) return false;
+#ifdef CAUSTICA_INSTANCED
+  InstanceXform xf = instanceXform(gLightInstance);  // the leaf's instance: its world-space triangle
+  TriGeom g = instanceTriangle(tri, xf);
+#else
   TriGeom g = triGeomAt(tri);
+#endif
   vec2 b = sampleTriangleUniform(uTri);
   ls.p = (1.0 - b.x - b.y) * g.v0.xyz + b.x * g.v1.xyz + b.y * g.v2.xyz;
   ls.pError = hitPointError(1.0 - b.x - b.y, b.x, b.y, g.v0.xyz, g.v1.xyz, g.v2.xyz);
+#ifdef CAUSTICA_INSTANCED
+  ls.pError += instancePointError(g, xf);
+#endif
   vec3 c = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
   float len = length(c);
   if (!(len > 0.0)) return false;
@@ -43,7 +64,11 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   vec2 uv = vec2(0.0);
 #ifdef CAUSTICA_TEXTURES
   vec2 t0, t1, t2;
+#ifdef CAUSTICA_INSTANCED
+  instanceUvs(tri, xf, t0, t1, t2);
+#else
   triUvs(tri, t0, t1, t2);  // tri_shade.glsl
+#endif
   uv = (1.0 - b.x - b.y) * t0 + b.x * t1 + b.y * t2;
 #endif
   ls.le = materialEmission(m, uv);

@@ -22,6 +22,9 @@ struct Hit {
   float u;   // barycentric weight of v1
   float v;   // barycentric weight of v2
   uint tri;  // index into triGeom[] (leaf order), kInvalidIndex when nothing was hit
+#ifdef CAUSTICA_INSTANCED
+  uint inst; // the Scene::instances index of the hit (instanced scenes: tri is a stored, object-space triangle)
+#endif
 };
 
 // Relative widening of a box's exit distance (as in intersectAabb): a stacked subtree is skipped only
@@ -52,6 +55,28 @@ void bvhTriangle(uint i, out vec3 p0, out vec3 p1, out vec3 p2) {
   p2 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i + 2u)).xyz);
 }
 
+// The two-level traversal (traceInstanced) and the instances' world-space triangles (instances.glsl,
+// empty without CAUSTICA_INSTANCED). Included always: the shader library expands #include before the
+// preprocessor runs, and a file is expanded once.
+#include "traverse_instanced.glsl"
+#include "instances.glsl"
+
+#ifdef CAUSTICA_INSTANCED
+// Instanced scenes: both queries go through the two-level traversal.
+
+bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
+  uint inst;
+  bool found = traceInstanced(org, dir, tmax, CAUSTICA_INSTANCE_RECORD_BASE, false, hit, inst);
+  hit.inst = inst;
+  return found;
+}
+
+bool traceOccluded(vec3 org, vec3 dir, float tmax) {
+  Hit hit;
+  uint inst;
+  return traceInstanced(org, dir, tmax, CAUSTICA_INSTANCE_RECORD_BASE, true, hit, inst);
+}
+#else
 // Closest hit with 0 < t < tmax. On a miss returns false with hit.t = tmax and hit.tri = kInvalidIndex.
 bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   hit.t = tmax;
@@ -157,3 +182,4 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   }
   return false;
 }
+#endif  // CAUSTICA_INSTANCED

@@ -1,6 +1,7 @@
 // traverse_instanced.glsl — two-level (instanced) traversal: twin of traverse<>() in app/accel/tlas.cpp;
-// keep the two in step. Include traverse.glsl first. Not used by the renderer yet
-// (docs/instancing-status.md); tested against the C++ twin by tests/gpu/traverse_gpu_test.cpp.
+// keep the two in step. Include traverse.glsl first (which includes this file under CAUSTICA_INSTANCED:
+// traceClosest/traceOccluded then call traceInstanced; docs/instancing.md); tested against
+// the C++ twin by tests/gpu/traverse_gpu_test.cpp.
 //
 // Layout (InstancedBvh, gpu_layout.h InstanceRecord): bvhNodeTexels holds the top-level nodes (root 0),
 // then every mesh's bottom-level nodes (refs rebased), then at node index recordBase + i the 4 texels
@@ -74,6 +75,9 @@ bool traceInstanced(vec3 worldOrg, vec3 worldDir, float tmax, uint recordBase, b
         bvhTriangle(i, p0, p1, p2);
         float t, u, v;
         if (intersectTriangleSheared(org, rs, p0, p1, p2, hit.t, t, u, v)) {
+#ifdef CAUSTICA_OCCLUDER_FILTER
+          if (anyHit && !CAUSTICA_OCCLUDER_FILTER(i)) continue;  // traverse.glsl's filter (Whitted)
+#endif
           hit.t = t;
           hit.u = u;
           hit.v = v;

@@ -96,7 +96,7 @@ CAUSTICA_CONST uint kBvhFirstMask = 0x07ffffffu;  // first triangle of a leaf: <
 CAUSTICA_CONST uint kBvhMaxLeafSize = 15u;         // 4 bits of count
 CAUSTICA_CONST uint kBvhEmptyRef = 0x80000000u;    // a leaf of no triangles
 
-// Instancing (docs/instancing-status.md; not read by the shaders yet): one record per instance, in
+// Instancing (docs/instancing.md): one record per instance, in
 // top-level leaf order, 64 bytes = 4 RGBA32 texels, meant to follow the BVH nodes in their buffer
 // texture. The top-level BVH's leaves are single instances (count 1, first = record index); a
 // bottom-level BVH's nodes and triangles are rebased into the shared node and TriGeom arrays.
@@ -110,10 +110,27 @@ struct InstanceRecord {
   uint flags;     // 0 (reserved)
 };
 
+// Shading data of one instance (64 bytes = 4 texels), indexed by Scene::instances index: in the node
+// buffer texture at node index CAUSTICA_INSTANCE_RECORD_BASE + CAUSTICA_INSTANCE_COUNT + instance,
+// after the InstanceRecords (glsl/lib/instances.glsl). Then, from texel CAUSTICA_LIGHT_LEAF_TABLE on,
+// the light-leaf table: one uint per (instance, emissive triangle of its mesh), 4 per texel, the
+// light-tree leaf node of that emitter (kInvalidIndex: not in the tree, zero power).
+struct InstanceShade {
+  vec4 row0;           // object-to-world affine map (rebased on Scene::origin), row 0: dot(row0.xyz, p) + row0.w
+  vec4 row1;           // row 1
+  vec4 row2;           // row 2
+  uint lightLeafBase;  // the instance's first entry in the light-leaf table (emissive meshes; else 0)
+  uint flags;          // kInstanceMirrored: negative determinant (corners 1 and 2 swap, as flattenInstances)
+  uint reserved0;      // 0
+  uint reserved1;      // 0
+};
+CAUSTICA_CONST uint kInstanceMirrored = 1u;
+
 // Triangle positions for intersection (48 bytes).
 struct TriGeom {
   vec4 v0;  // xyz: vertex 0 (world space); w: material index (stored as float bits of a uint)
-  vec4 v1;  // xyz: vertex 1; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0
+  vec4 v1;  // xyz: vertex 1; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0;
+            // instanced scenes (object-space vertices): index among its mesh's emissive triangles + 1
   vec4 v2;  // xyz: vertex 2; w unused
 };
 
@@ -182,6 +199,7 @@ struct LightNode {
 };
 CAUSTICA_CONST uint kLightNodeLeaf = 1u;       // LightNode.link.y: a leaf (one triangle)
 CAUSTICA_CONST uint kLightNodeTwoSided = 2u;   // LightNode.link.y: some triangle below emits from both faces
+CAUSTICA_CONST uint kLightNodeInstanceShift = 2u;  // instanced scenes: a leaf's link.y >> this = its Scene::instances index
 #define CAUSTICA_LIGHT_TREE_DEPTH 32           // bits of the trail: the builder keeps every leaf's depth <= this
 
 // ---- UBO ---------------------------------------------------------------------------------------
@@ -259,6 +277,7 @@ static_assert(sizeof(PunctualLight) == 64, "PunctualLight must be 64 bytes (std1
 static_assert(sizeof(PunctualParams) == 16 + 64 * CAUSTICA_MAX_PUNCTUAL, "PunctualParams must match std140");
 static_assert(sizeof(BvhNode) == 64, "BvhNode must be 64 bytes (4 texels)");
 static_assert(sizeof(InstanceRecord) == 64, "InstanceRecord must be 64 bytes (4 texels)");
+static_assert(sizeof(InstanceShade) == 64, "InstanceShade must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");

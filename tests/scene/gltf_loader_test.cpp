@@ -1156,3 +1156,34 @@ TEST_CASE("instancing: limits count stored triangles; bad EXT_mesh_gpu_instancin
             {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", t}, {"SCALE", sc}}}}}}}});
   CHECK(loadError(dir.write("bad.gltf", bad.text())).find("different counts") != std::string::npos);
 }
+
+TEST_CASE("instancing: autoInstances keeps instances only where flattening multiplies the triangles") {
+  TempDir dir;
+  const auto scene = [&](int nodes) {
+    Gltf g;
+    const int mesh = g.mesh({{"attributes", {{"POSITION", g.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0})}}},
+                             {"material", g.diffuse()}});
+    for (int i = 0; i < nodes; ++i) g.root({{"mesh", mesh}, {"translation", {double(i), 0.0, 0.0}}});
+    return dir.write("nodes" + std::to_string(nodes) + ".gltf", g.text());
+  };
+  caustica::LoadOptions opts;
+  opts.keepInstances = opts.autoInstances = true;  // --instances auto (factor 4)
+  const Scene four = caustica::loadScene(scene(4), opts);  // 4x the stored triangles: flattened
+  CHECK(four.instances.empty());
+  CHECK(four.triangles.size() == 8);
+  const Scene five = caustica::loadScene(scene(5), opts);  // 5x: kept
+  CHECK(five.instances.size() == 5);
+  CHECK(five.triangles.size() == 2);
+  opts.maxTriangles = 7;  // 8 flattened triangles exceed the limit: kept, whatever the factor
+  const Scene limited = caustica::loadScene(scene(4), opts);
+  CHECK(limited.instances.size() == 4);
+  // The flattened load is the plain one, bit for bit (not flattenInstances' float normals).
+  caustica::LoadOptions plain;
+  const Scene flat = caustica::loadScene(scene(4), plain);
+  REQUIRE(flat.triangles.size() == four.triangles.size());
+  for (std::size_t i = 0; i < flat.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      CHECK(flat.triangles[i].p[k] == four.triangles[i].p[k]);
+      CHECK(flat.triangles[i].n[k] == four.triangles[i].n[k]);
+    }
+}

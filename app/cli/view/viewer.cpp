@@ -40,6 +40,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   scene_ = loadSceneForCli(opts, !config_.quiet);
   sceneName_ = fileStem(scene_.scene.path);
   RenderSettings settings = renderSettingsFrom(opts, scene_.camera, kDefaultWidth);
+  if (settings.mode == RenderMode::Raster) flattenForRaster(scene_.scene, opts, config_.quiet);
+  controls_.rasterAllowed = scene_.scene.instances.empty();  // M skips raster for an instanced scene
   controls_.wanted = settings;
   controls_.tone = config_.tone;
   controls_.stopAtTarget = config_.targetError > 0.0;
