@@ -1,5 +1,6 @@
-// pathtrace.comp — the path tracer entry shader: one invocation per pixel and one sample per
-// dispatch; eye rays bounce until they reach emitters (naive) or also sample lights (CAUSTICA_MIS).
+// pathtrace.comp — the path tracer entry shader: one invocation per pixel tracing K samples of it in one
+// flat bounce loop (path regeneration: a lane starts its next sample as soon as a path ends); eye rays
+// bounce until they reach emitters (naive) or also sample lights (CAUSTICA_MIS).
 // Radiance is linear; throughput is per RGB channel; wavelengths in nm.
 #include "lib/bindings.glsl"
 #include "lib/rng.glsl"
@@ -30,8 +31,6 @@
 #include "lib/adaptive.glsl"
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
-
-shared uint groupCounts[4];  // primary, secondary, shadow rays, non-finite samples
 
 uint gSecondaryRays = 0u;
 const uint kMaxPassThroughs = 256u;  // alpha pass-throughs a path may make beyond its bounces
@@ -78,37 +77,70 @@ float glassIor(Material m, inout float lambda, inout vec3 filt, inout uvec4 rng)
   return ior;
 }
 
-// One path sample for the pixel; returns its radiance estimate (may be non-finite: the caller checks).
-vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
-  vec3 org = frame.camPos.xyz;
-  vec3 dir = eyeRayDirection(pixel, rand2(rng));
-  vec3 beta = vec3(1.0);   // path throughput
-  float etaScale = 1.0;    // product of eta^2 over refractions: beta * etaScale is free of radiance scaling
-  vec3 radiance = vec3(0.0);
-  vec3 filt = vec3(1.0);   // per-channel weight of the wavelength(s) the path carries (dispersion)
-  float lambda = 0.0;      // nm; 0 while the path still carries every wavelength
-  float prevPdf = 0.0;     // solid-angle pdf of the last BSDF sample (non-delta lobes)
-  bool prevDelta = true;   // last direction came from the camera or a delta lobe: no MIS on emitter hits
-  vec3 prevP = vec3(0.0), prevN = vec3(0.0);  // last vertex's point and shading normal (light-tree pdf for MIS)
-  vec3 sigma = vec3(0.0);  // absorption coefficient of the medium the ray travels in (per scene unit)
-  uint maxDepth = frame.options.x;
-  bool firstDiffuse = true;  // no diffuse vertex yet on this path
+// The state of one path sample between bounces (world space; radiance linear, per RGB channel).
+struct PathState {
+  vec3 org, dir;
+  vec3 beta;           // path throughput
+  float etaScale;      // product of eta^2 over refractions: beta * etaScale is free of radiance scaling
+  vec3 radiance;       // estimate so far
+  vec3 filt;           // per-channel weight of the wavelength(s) the path carries (dispersion)
+  float lambda;        // nm; 0 while the path still carries every wavelength
+  float prevPdf;       // solid-angle pdf of the last BSDF sample (non-delta lobes)
+  bool prevDelta;      // last direction came from the camera or a delta lobe: no MIS on emitter hits
+  vec3 prevP, prevN;   // last vertex's point and shading normal (light-tree pdf for MIS)
+  vec3 sigma;          // absorption coefficient of the medium the ray travels in (per scene unit)
+  bool firstDiffuse;   // no diffuse vertex yet on this path
+  uint depth;          // bounces so far (path segments traced, alpha pass-throughs not counted)
+  uint passThroughs;   // alpha pass-throughs: not bounces, so they do not consume the depth cap
+  uvec4 rng;
+};
 
-  uint passThroughs = 0u;  // alpha pass-throughs: not bounces, so they do not consume the depth cap
-  for (uint depth = 0u; depth < maxDepth; ++depth) {
-    if (depth + passThroughs > 0u) ++gSecondaryRays;
+// Sample `sampleIndex` (global) of the pixel: its random stream, keyed by (pixel, sample index, seed),
+// and its camera ray.
+PathState startPath(uvec2 pixel, uint sampleIndex) {
+  PathState s;
+  s.rng = rngSeed(pixel.y * frame.frame.x + pixel.x, sampleIndex, frame.frame.w);
+  s.org = frame.camPos.xyz;
+  s.dir = eyeRayDirection(pixel, rand2(s.rng));
+  s.beta = vec3(1.0);
+  s.etaScale = 1.0;
+  s.radiance = vec3(0.0);
+  s.filt = vec3(1.0);
+  s.lambda = 0.0;
+  s.prevPdf = 0.0;
+  s.prevDelta = true;
+  s.prevP = vec3(0.0);
+  s.prevN = vec3(0.0);
+  s.sigma = vec3(0.0);
+  s.firstDiffuse = true;
+  s.depth = 0u;
+  s.passThroughs = 0u;
+#ifdef CAUSTICA_TRANSPARENT
+  gCameraRayMissed = false;
+#endif
+  return s;
+}
+
+// One bounce of the path: traces its ray, adds what it finds to s.radiance and samples the next
+// direction. Returns false when the path has ended (escaped, absorbed, lost or ended by roulette);
+// the caller also ends it at the depth cap (frame.options.x).
+bool pathBounce(inout PathState s) {
+  uint maxDepth = frame.options.x;
+  uint depth = s.depth;
+  {  // (the body of the former per-sample bounce loop)
+    if (depth + s.passThroughs > 0u) ++gSecondaryRays;
     Hit hit;
-    if (!traceClosest(org, dir, 3.0e38, hit)) {
+    if (!traceClosest(s.org, s.dir, 3.0e38, hit)) {
 #ifdef CAUSTICA_TRANSPARENT
       if (depth == 0u) gCameraRayMissed = true;  // alpha 0 for this sample (coverage.glsl)
 #endif
 #ifdef CAUSTICA_ENV
-      radiance += beta * filt * escapedRadiance(dir, depth == 0u, prevDelta, prevPdf);  // environment_light.glsl
+      s.radiance += s.beta * s.filt * escapedRadiance(s.dir, depth == 0u, s.prevDelta, s.prevPdf);  // environment_light.glsl
 #endif
-      break;
+      return false;
     }
 #ifdef CAUSTICA_VOLUME
-    beta *= exp(-sigma * hit.t);
+    s.beta *= exp(-s.sigma * hit.t);
 #endif
 #ifdef CAUSTICA_INSTANCED
     InstanceXform xf = instanceXform(hit.inst);
@@ -131,9 +163,9 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
 #endif
     vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
     float crLen = length(cr);
-    if (!(crLen > 0.0)) break;
+    if (!(crLen > 0.0)) return false;
     vec3 ngFront = cr / crLen;              // geometric normal of the front (counter-clockwise) face
-    bool front = dot(dir, ngFront) < 0.0;
+    bool front = dot(s.dir, ngFront) < 0.0;
     vec3 ng = front ? ngFront : -ngFront;   // geometric normal on the side the ray came from
     vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
     float nsLen = length(nsRaw);
@@ -150,220 +182,227 @@ vec3 tracePath(uvec2 pixel, inout uvec4 rng) {
     if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) {
       float w = 1.0;
 #ifdef CAUSTICA_SPOT_EMITTERS
-      w *= spotEmitterFactor(m, -dir);  // a --light-radius sphere of a spot light emits into its cone
+      w *= spotEmitterFactor(m, -s.dir);  // a --light-radius sphere of a spot light emits into its cone
 #endif
 #ifdef CAUSTICA_MIS
-      if (!prevDelta) {
+      if (!s.prevDelta) {
 #ifdef CAUSTICA_INSTANCED
-        float pdfLight = instanceLightPdfArea(g, xf, prevP, prevN) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
+        float pdfLight = instanceLightPdfArea(g, xf, s.prevP, s.prevN) * hit.t * hit.t / max(abs(dot(ngFront, s.dir)), 1.0e-12);
 #else
-        float pdfLight = lightPdfArea(hit.tri, prevP, prevN) * hit.t * hit.t / max(abs(dot(ngFront, dir)), 1.0e-12);
+        float pdfLight = lightPdfArea(hit.tri, s.prevP, s.prevN) * hit.t * hit.t / max(abs(dot(ngFront, s.dir)), 1.0e-12);
 #endif
-        w *= powerHeuristic(prevPdf, pdfLight);
+        w *= powerHeuristic(s.prevPdf, pdfLight);
       }
 #endif
-      radiance += beta * filt * materialEmission(m, uv) * w;
+      s.radiance += s.beta * s.filt * materialEmission(m, uv) * w;
     }
 
     vec4 base = materialBaseColor(m, uv);
 #ifdef CAUSTICA_OPACITY
-    if (base.a < 1.0 && rand01(rng) >= base.a) {  // pass straight through (a delta event)
-      org = offsetRayOrigin(p, pError, -ng);
-      prevDelta = true;
-      if (passThroughs < kMaxPassThroughs) {  // up to that many layers of cut-outs are free
-        ++passThroughs;
-        --depth;  // uint: wraps to the maximum at depth 0, and the loop's ++depth brings it back
-      }
-      continue;
+    if (base.a < 1.0 && rand01(s.rng) >= base.a) {  // pass straight through (a delta event)
+      s.org = offsetRayOrigin(p, pError, -ng);
+      s.prevDelta = true;
+      if (s.passThroughs < kMaxPassThroughs) ++s.passThroughs;  // up to that many layers of cut-outs are free
+      else ++s.depth;
+      return true;
     }
 #endif
 
     vec3 newDir;
     vec2 metalRough = materialMetalRough(m, uv);
-    uint lobe = chooseLobe(m, metalRough.x, metalRough.y, rand01(rng));
+    uint lobe = chooseLobe(m, metalRough.x, metalRough.y, rand01(s.rng));
     if (lobe == kLobeDiffuse) {
 #ifdef CAUSTICA_CASTERS
       // Cosine sampling mixed with directions aimed at glass and mirror objects (casters.glsl): more
       // paths reach the caustics they focus; the mixture pdf keeps the estimate unbiased and enters MIS.
       // Only at the path's first diffuse vertex (the caustics the camera sees; deeper vertices gain
       // less than they cost, docs/path-tracer.md), and not at the last vertex the depth limit allows.
-      float uChoose = rand01(rng);
-      if (firstDiffuse && depth + 1u < maxDepth) prepareCasters(p, ns, uChoose);
+      float uChoose = rand01(s.rng);
+      if (s.firstDiffuse && depth + 1u < maxDepth) prepareCasters(p, ns, uChoose);
       else gCasterUsable = 0u;
-      firstDiffuse = false;
-      float uPick = rand01(rng);
-      newDir = sampleDiffuseDirection(ns, uPick, rand2(rng));
+      s.firstDiffuse = false;
+      float uPick = rand01(s.rng);
+      newDir = sampleDiffuseDirection(ns, uPick, rand2(s.rng));
 #endif
 #if defined(CAUSTICA_MIS) || defined(CAUSTICA_PUNCTUAL)
       // The Lambertian vertex as every light estimate below sees it (vertex.glsl), built once.
-      Vertex v = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, dir, sigma, sigma);
+      Vertex v = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, s.dir, s.sigma, s.sigma);
 #endif
 #ifdef CAUSTICA_MIS
       // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
       // traced (not at the last vertex the depth limit allows), so both estimators end alike.
       if (depth + 1u < maxDepth) {
-        radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
+        s.radiance += s.beta * s.filt * sampleEmitterLight(v, s.rng, gShadowRays);
       }
       // The environment's and the punctual lights' numbers are drawn in every shader variant, with the
       // feature or without: all variants then draw the same random numbers for the same path, so the
       // all-features shader renders the specialised shader's image to float rounding (a test compares).
-      vec2 uEnv = rand2(rng);
+      vec2 uEnv = rand2(s.rng);
 #ifdef CAUSTICA_ENV
       // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
       // Not inside an absorbing medium: the ray could only leave through its boundary.
-      if (depth + 1u < maxDepth && sigma == vec3(0.0)) radiance += beta * filt * addEnvironmentLight(v, uEnv);
+      if (depth + 1u < maxDepth && s.sigma == vec3(0.0)) s.radiance += s.beta * s.filt * addEnvironmentLight(v, uEnv);
 #endif
 #endif
-      float uPunctual = rand01(rng);
+      float uPunctual = rand01(s.rng);
 #ifdef CAUSTICA_PUNCTUAL
       // Punctual lights: their own estimate, added to the emitters' (a sum of unbiased estimates);
       // in both integrators, since a bounce never finds a delta light.
-      if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(v, uPunctual);
+      if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * addPunctualLight(v, uPunctual);
 #endif
 #ifdef CAUSTICA_CASTERS
       float cosOut = dot(newDir, ns);
-      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) break;  // below the true surface: absorbed
+      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) return false;  // below the true surface: absorbed
       float pdfDir = diffuseDirectionPdf(ns, newDir);
-      beta *= base.rgb * (cosOut * INV_PI / pdfDir);
-      prevPdf = pdfDir;
+      s.beta *= base.rgb * (cosOut * INV_PI / pdfDir);
+      s.prevPdf = pdfDir;
 #else
       vec3 t, b;
       orthonormalBasis(ns, t, b);
-      vec3 local = sampleCosineHemisphere(rand2(rng));
+      vec3 local = sampleCosineHemisphere(rand2(s.rng));
       newDir = normalize(local.x * t + local.y * b + local.z * ns);
       float cosOut = dot(newDir, ns);
-      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) break;  // below the true surface: absorbed
-      beta *= base.rgb;
-      prevPdf = cosOut * INV_PI;
+      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) return false;  // below the true surface: absorbed
+      s.beta *= base.rgb;
+      s.prevPdf = cosOut * INV_PI;
 #endif
-      prevDelta = false;
+      s.prevDelta = false;
     }
 #ifdef CAUSTICA_MIRROR
     else if (lobe == kLobeMirror) {
-      newDir = reflect(dir, ns);
-      if (dot(newDir, ng) <= 0.0) newDir = reflect(dir, ng);
-      beta *= base.rgb;
-      prevDelta = true;
+      newDir = reflect(s.dir, ns);
+      if (dot(newDir, ng) <= 0.0) newDir = reflect(s.dir, ng);
+      s.beta *= base.rgb;
+      s.prevDelta = true;
     }
 #endif
 #ifdef CAUSTICA_GGX
     else if (lobe >= kLobeConductor) {  // GGX lobes: rough metal, plastic, rough glass (microfacet.glsl)
       float eta = 1.0;
-      vec3 sigmaBelow = sigma;
+      vec3 sigmaBelow = s.sigma;
 #ifdef CAUSTICA_GLASS
       if (lobe == kLobeRoughGlass) {
-        float ior = glassIor(m, lambda, filt, rng);
+        float ior = glassIor(m, s.lambda, s.filt, s.rng);
         eta = front ? ior : 1.0 / ior;  // n beyond the surface / n on the ray's side
 #ifdef CAUSTICA_VOLUME
         sigmaBelow = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
 #endif
       }
 #endif
-      Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, metalRough.y, eta), p, pError, ng, ns, dir, sigma, sigmaBelow);
+      Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, metalRough.y, eta), p, pError, ng, ns, s.dir, s.sigma, sigmaBelow);
 #ifdef CAUSTICA_MIS
-      if (depth + 1u < maxDepth) radiance += beta * filt * sampleEmitterLight(v, rng, gShadowRays);
+      if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * sampleEmitterLight(v, s.rng, gShadowRays);
 #endif
 #ifdef CAUSTICA_MIS
-      vec2 uEnv = rand2(rng);  // drawn with or without the feature, as at diffuse vertices
+      vec2 uEnv = rand2(s.rng);  // drawn with or without the feature, as at diffuse vertices
 #ifdef CAUSTICA_ENV
       // The environment's next-event estimate through this lobe (both sides for rough glass), matching
       // the MIS weight escaped rays get after this vertex (environment_light.glsl).
       if (depth + 1u < maxDepth)
-        radiance += beta * filt * addEnvironmentLight(v, uEnv);
+        s.radiance += s.beta * s.filt * addEnvironmentLight(v, uEnv);
 #endif
 #endif
-      float uPunctual = rand01(rng);
+      float uPunctual = rand01(s.rng);
 #ifdef CAUSTICA_PUNCTUAL
-      if (depth + 1u < maxDepth) radiance += beta * filt * addPunctualLight(v, uPunctual);
+      if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * addPunctualLight(v, uPunctual);
 #endif
       BsdfSample bs;
-      float uPart = rand01(rng);
-      if (!bsdfSample(v.bsdf, v.wo, vec3(uPart, rand2(rng)), bs)) break;
+      float uPart = rand01(s.rng);
+      if (!bsdfSample(v.bsdf, v.wo, vec3(uPart, rand2(s.rng)), bs)) return false;
       newDir = vertexToWorld(v, bs.wi);
-      if (bs.transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0) break;  // through the true surface: lost
-      beta *= bs.weight;
-      prevPdf = bs.pdf;
-      prevDelta = false;
+      if (bs.transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0) return false;  // through the true surface: lost
+      s.beta *= bs.weight;
+      s.prevPdf = bs.pdf;
+      s.prevDelta = false;
       if (bs.transmitted) {
-        etaScale *= eta * eta;
-        sigma = sigmaBelow;
+        s.etaScale *= eta * eta;
+        s.sigma = sigmaBelow;
       }
     }
 #endif
 #ifdef CAUSTICA_GLASS
     else {
-      float ior = glassIor(m, lambda, filt, rng);
+      float ior = glassIor(m, s.lambda, s.filt, s.rng);
       float eta = front ? ior : 1.0 / ior;  // n_transmitted / n_incident
       bool transmitted;
-      float u = rand01(rng);
-      float weight = sampleDielectric(dir, ns, eta, u, newDir, transmitted);
+      float u = rand01(s.rng);
+      float weight = sampleDielectric(s.dir, ns, eta, u, newDir, transmitted);
       if (transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0)  // shading normal misled: use ng
-        weight = sampleDielectric(dir, ng, eta, u, newDir, transmitted);
-      beta *= weight;
+        weight = sampleDielectric(s.dir, ng, eta, u, newDir, transmitted);
+      s.beta *= weight;
       if (transmitted) {
-        beta *= base.rgb;  // KHR_materials_transmission: transmitted light is tinted by the base colour
-        etaScale *= eta * eta;
+        s.beta *= base.rgb;  // KHR_materials_transmission: transmitted light is tinted by the base colour
+        s.etaScale *= eta * eta;
       }
 #ifdef CAUSTICA_VOLUME
-      if (transmitted) sigma = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
+      if (transmitted) s.sigma = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
 #endif
-      prevDelta = true;
+      s.prevDelta = true;
     }
 #endif
 
-    // Russian roulette after a few bounces, on the throughput without the eta^2 radiance scaling
+    // Russian roulette after a few bounces, on the throughput without the eta^2 s.radiance scaling
     // (inside glass that factor is not an energy loss and must not end paths; pbrt-v4 does the same),
-    // times the dispersion filter: after a dispersive event the path carries filt (3 in one channel,
+    // times the dispersion filter: after a dispersive event the path carries s.filt (3 in one channel,
     // or the hero wavelength's sensitivity / pdf), and ignoring it ended those paths up to 3x too
     // often (cornell-dispersion 64x64: 1.3-2.1x the efficiency; docs/benchmarks.md).
     if (depth >= 3u) {
-      float q = min(maxComponent(beta * filt) * etaScale, 1.0);
-      if (rand01(rng) >= q) break;
-      beta /= q;
+      float q = min(maxComponent(s.beta * s.filt) * s.etaScale, 1.0);
+      if (rand01(s.rng) >= q) return false;
+      s.beta /= q;
     }
-    dir = newDir;
-    org = offsetRayOrigin(p, pError, dot(dir, ng) > 0.0 ? ng : -ng);
-    prevP = p;
-    prevN = ns;
+    s.dir = newDir;
+    s.org = offsetRayOrigin(p, pError, dot(s.dir, ng) > 0.0 ? ng : -ng);
+    s.prevP = p;
+    s.prevN = ns;
+    ++s.depth;
+    return true;
   }
-  return radiance;
 }
 
 void main() {
   uvec2 pixel;
   bool valid = dispatchedPixel(pixel);  // adaptive.glsl: rows of frame.tile, or a live tile
-  if (gl_LocalInvocationIndex == 0u) {
-    groupCounts[0] = 0u;
-    groupCounts[1] = 0u;
-    groupCounts[2] = 0u;
-    groupCounts[3] = 0u;
-  }
-  memoryBarrierShared();
-  barrier();
-  // One sample per invocation: more would run into llvmpipe's cap on nested loop iterations
-  // (see Renderer::renderRows); the host dispatches once per sample.
+  // K = frame.options.w samples of the pixel, sample indices frame.frame.z .. + K - 1, in one flat
+  // loop of bounces: when a path ends its lane starts the next sample at once, so a long path holds
+  // its SIMD neighbours only until their own K samples are done, not once per sample. Mesa's llvmpipe
+  // caps a shader's loop iterations (65535 in all, then silently leaves the loops): the host chooses
+  // K so that K * (depth cap + alpha pass-throughs) stays within the bound measured safe
+  // (Renderer::samplesPerDispatch). Samples are accumulated in the order of their indices, exactly as
+  // K dispatches of one sample would add them, so the image does not depend on K.
   uint primary = 0u, bad = 0u;
   if (valid) {
-    uvec4 rng = rngSeed(pixel.y * frame.frame.x + pixel.x, frame.frame.z, frame.frame.w);
-    vec3 l = tracePath(pixel, rng);
-    primary = 1u;
-    bool finite = !(any(isnan(l)) || any(isinf(l)));
-    if (!finite) bad = 1u;  // counted and reported; not part of the pixel's mean (neither as black)
-    accumulate(ivec2(pixel), finite ? l : vec3(0.0), finite ? 1.0 : 0.0);
+    uint samples = max(frame.options.w, 1u);
+    uint maxDepth = frame.options.x;
+    PixelSums sums = loadPixelSums(ivec2(pixel));  // accumulate.glsl
 #ifdef CAUSTICA_TRANSPARENT
-    accumulateCoverage(ivec2(pixel), finite && !gCameraRayMissed ? 1.0 : 0.0);
+    float covered = loadCoverage(ivec2(pixel));  // coverage.glsl
+#endif
+    uint k = 0u;
+    PathState path = startPath(pixel, frame.frame.z);
+    while (true) {
+      if (path.depth < maxDepth && pathBounce(path)) continue;
+      vec3 l = path.radiance;
+      bool finite = !(any(isnan(l)) || any(isinf(l)));
+      if (!finite) ++bad;  // counted and reported; not part of the pixel's mean (neither as black)
+      addSample(sums, finite ? l : vec3(0.0), finite ? 1.0 : 0.0);
+#ifdef CAUSTICA_TRANSPARENT
+      covered += finite && !gCameraRayMissed ? 1.0 : 0.0;
+#endif
+      if (++k == samples) break;
+      path = startPath(pixel, frame.frame.z + k);
+    }
+    primary = samples;
+    storePixelSums(ivec2(pixel), sums);
+#ifdef CAUSTICA_TRANSPARENT
+    storeCoverage(ivec2(pixel), covered);
 #endif
   }
-  atomicAdd(groupCounts[0], primary);
-  atomicAdd(groupCounts[1], gSecondaryRays);
-  atomicAdd(groupCounts[2], gShadowRays);
-  atomicAdd(groupCounts[3], bad);
-  memoryBarrierShared();
-  barrier();
-  if (gl_LocalInvocationIndex == 0u) {
-    atomicAdd(counters.primaryRays, groupCounts[0]);
-    atomicAdd(counters.secondaryRays, groupCounts[1]);
-    atomicAdd(counters.shadowRays, groupCounts[2]);
-    atomicAdd(counters.nonFinite, groupCounts[3]);
-  }
+  // Ray and sample counts straight into the counters, one atomic per non-zero count: a reduction in
+  // shared memory needs barrier(), which made the whole shader 9-13 % slower on llvmpipe
+  // (docs/benchmarks.md, "Path regeneration").
+  if (primary > 0u) atomicAdd(counters.primaryRays, primary);
+  if (gSecondaryRays > 0u) atomicAdd(counters.secondaryRays, gSecondaryRays);
+  if (gShadowRays > 0u) atomicAdd(counters.shadowRays, gShadowRays);
+  if (bad > 0u) atomicAdd(counters.nonFinite, bad);
 }

@@ -49,7 +49,8 @@ BudgetResult renderWithBudget(Renderer& renderer, const RenderBudget& budget, co
       result.reason = StopReason::Time;
       break;
     }
-    int n = std::min(batch, budget.maxSpp - spp);
+    // At least the samples one dispatch traces (path regeneration, Renderer::samplesPerDispatch).
+    int n = std::min(std::max(batch, renderer.samplesPerDispatch()), budget.maxSpp - spp);
     if (sampler) n = std::min(n, nextCheck - spp);
     if (budget.seconds > 0.0 && secondsPerSample > 0.0)  // do not run far past the time budget
       n = std::max(1, std::min(n, static_cast<int>((budget.seconds - now) / secondsPerSample) + 1));

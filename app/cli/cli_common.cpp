@@ -132,6 +132,9 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--all-features", "", "",
        "compile every material feature into the path tracer instead of the scene's (measures specialisation; "
        "same image)"},
+      {"--samples-per-dispatch", "", "K",
+       "path tracer: samples per pixel per GPU dispatch (0 = automatic, the default; lowered where the depth cap "
+       "needs it); changes the speed, never the image"},
       {"--quiet", "-q", "", "print nothing but errors"},
   };
   for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
@@ -254,7 +257,8 @@ bool renderWithProgress(Renderer& renderer, int targetSpp, const std::string& la
   bool stopped = false;
   while (renderer.samplesPerPixel() < targetSpp) {
     double t0 = seconds();
-    renderer.renderPass(std::min(batch, targetSpp - renderer.samplesPerPixel()));
+    // At least the samples one dispatch traces (path regeneration, Renderer::samplesPerDispatch).
+    renderer.renderPass(std::min(std::max(batch, renderer.samplesPerDispatch()), targetSpp - renderer.samplesPerPixel()));
     double dt = seconds() - t0;
     if (dt < 0.05 && batch < 256) batch *= 2;
     else if (dt > 0.5 && batch > 1) batch /= 2;
@@ -351,6 +355,7 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
     throw Error(m.str());
   }
   s.allFeatures = opts.has("--all-features");
+  s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
   s.validate();
   return s;
 }

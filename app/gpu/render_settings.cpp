@@ -39,6 +39,8 @@ void RenderSettings::validate() const {
                 std::to_string(kMaxImageSide) + " pixels per side");
   if (maxDepth < kMinMaxDepth || maxDepth > kMaxMaxDepth)
     throw Error("max depth must be between " + std::to_string(kMinMaxDepth) + " and " + std::to_string(kMaxMaxDepth));
+  if (samplesPerDispatch < 0 || samplesPerDispatch > kMaxSamplesPerDispatch)
+    throw Error("samples per dispatch must be between 0 (automatic) and " + std::to_string(kMaxSamplesPerDispatch));
   if (!(casterProbability >= 0.0f && casterProbability <= kMaxCasterProbability)) {
     std::ostringstream m;
     m << "caster probability must be between 0 and " << kMaxCasterProbability;
@@ -49,7 +51,7 @@ void RenderSettings::validate() const {
 bool RenderSettings::operator==(const RenderSettings& o) const {
   return width == o.width && height == o.height && seed == o.seed && maxDepth == o.maxDepth &&
          integrator == o.integrator && dispersion == o.dispersion && casterProbability == o.casterProbability &&
-         mode == o.mode && allFeatures == o.allFeatures;
+         mode == o.mode && allFeatures == o.allFeatures && samplesPerDispatch == o.samplesPerDispatch;
 }
 
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to) {

@@ -22,6 +22,7 @@ constexpr int kMinMaxDepth = 1;                   // bounds of RenderSettings::m
 constexpr int kMaxMaxDepth = 1024;
 constexpr float kMaxCasterProbability = 0.9f;     // every direction keeps a non-zero cosine pdf
 constexpr int kMaxImageSide = 16384;              // pixels; the GPU's texture limit may be lower
+constexpr int kMaxSamplesPerDispatch = 64;        // bound of RenderSettings::samplesPerDispatch
 
 struct RenderSettings {
   int width = 512, height = 512;  // pixels
@@ -40,6 +41,10 @@ struct RenderSettings {
   // otherwise specialised to the scene's features): measures what specialisation saves
   // (docs/benchmarks.md). The expected image does not change.
   bool allFeatures = false;
+  // Samples per pixel one path-tracing dispatch traces (path regeneration, pathtrace.comp): 0 chooses
+  // automatically; any value is lowered to what keeps llvmpipe's loop cap out of reach for the depth
+  // cap (Renderer::samplesPerDispatch). The image does not depend on it, only the speed.
+  int samplesPerDispatch = 0;
 
   // Throws Error naming the first setting out of range.
   void validate() const;

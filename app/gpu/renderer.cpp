@@ -325,7 +325,28 @@ ErrorEstimate Renderer::errorEstimate(int tileSize) const {
                        tileSize);
 }
 
-// One dispatch per sample: rows [y0, y1), or with `tiles` one work group per live tile.
+namespace {
+// llvmpipe caps the iterations of all a shader's loops together at 65535 per SIMD group and silently
+// leaves them beyond (docs/architecture.md). A dispatch of K samples per pixel runs at most
+// K * (depth cap + pass-throughs) bounce iterations per lane, each with its traversal loops; one
+// sample at the largest depth cap (1024) is the bound the deep tests (invisible sphere, glass cube in
+// a furnace, depth 1024) check to lose no energy, so K samples get that bound and no more.
+constexpr int kRegenBounceBudget = 1024;
+constexpr int kDefaultSamplesPerDispatch = 4;  // docs/benchmarks.md, "Path regeneration"
+constexpr int kMaxPassThroughs = 256;          // pathtrace.comp's kMaxPassThroughs
+}  // namespace
+
+int Renderer::samplesPerDispatch() const {
+  if (settings_.mode != RenderMode::Path) return 1;  // whitted.comp traces one sample per dispatch
+  const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
+  int perSample = settings_.maxDepth;
+  const std::vector<std::string> defines = shaderDefines();
+  if (std::find(defines.begin(), defines.end(), "CAUSTICA_OPACITY") != defines.end()) perSample += kMaxPassThroughs;
+  return std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
+}
+
+// Rows [y0, y1), or with `tiles` one work group per live tile; samplesPerDispatch() samples per pixel
+// in each dispatch.
 void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   const GlProgram& prog = program();
   const int w = settings_.width, h = settings_.height;
@@ -354,30 +375,37 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);
   tileList_.bindImage(CAUSTICA_IMAGE_TILES, GL_READ_ONLY);
   if (hasAlpha()) coverage_.bindImage(CAUSTICA_IMAGE_COVERAGE, GL_READ_WRITE);
-  // One sample per pixel per dispatch. Mesa's llvmpipe caps the iterations of a shader's nested
-  // loops together (65535 from the outermost loop's start) and silently stops beyond; a per-sample
-  // dispatch keeps long glass paths under that cap. Sample indices stay global, so the image does not
-  // depend on how samples are split.
+  // K samples per pixel per dispatch (samplesPerDispatch(): within llvmpipe's loop cap). Sample
+  // indices stay global, so the image does not depend on how samples are split into dispatches.
   // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
   // (a sample traces at most 2 * maxDepth + 1 rays, plus one per alpha pass-through: at most 256).
   const std::uint64_t pixelsPerDispatch =
       tiles ? std::uint64_t(liveTiles_) * std::uint64_t(liveTileSize_ * liveTileSize_)
             : static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0);
-  const std::uint64_t raysPerDispatch = pixelsPerDispatch * (2u * settings_.maxDepth + 1u + 256u);
+  const std::uint64_t raysPerSample = pixelsPerDispatch * (2u * settings_.maxDepth + 1u + 256u);
   // Tile lists: one work group per 64 / tileSize^2 live tiles (adaptive.glsl), on a 2D grid, since one
   // dimension may hold only 65535 groups.
   const GLuint tilesPerGroup = GLuint(CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y / (liveTileSize_ * liveTileSize_));
   const GLuint liveGroups = (liveTiles_ + tilesPerGroup - 1) / tilesPerGroup;
   const GLuint groupsX = tiles ? std::min<GLuint>(liveGroups, 65535u) : GLuint((w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X);
   const GLuint groupsY = tiles ? (liveGroups + groupsX - 1) / groupsX : GLuint((y1 - y0 + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
-  const int dispatchesPerRead = static_cast<int>(std::max<std::uint64_t>(1, (1ull << 31) / raysPerDispatch));
-  for (int s = 0; s < spp; ++s) {
-    if (s > 0 && s % dispatchesPerRead == 0) readCounters();
+  const int perDispatch = samplesPerDispatch();
+  const std::uint64_t samplesPerRead = std::max<std::uint64_t>(1, (1ull << 31) / raysPerSample);
+  std::uint64_t sinceRead = 0;  // samples dispatched since the counters were last read
+  fp.listed = glm::uvec4(GLuint(liveTileSize_), 0u, 0u, 0u);
+  for (int s = 0; s < spp;) {
+    const int k = static_cast<int>(std::min<std::uint64_t>({std::uint64_t(perDispatch), std::uint64_t(spp - s), samplesPerRead}));
+    if (sinceRead + k > samplesPerRead) {
+      readCounters();
+      sinceRead = 0;
+    }
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), GLuint(liveTileSize_));
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), std::uint32_t(k));
     frameUbo_.update(0, sizeof fp, &fp);
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+    s += k;
+    sinceRead += k;
   }
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   checkGlError("path tracing dispatch");

@@ -90,6 +90,11 @@ class Renderer {
   ErrorEstimate errorEstimate(int tileSize = CAUSTICA_WORKGROUP_X) const;
 
   int samplesPerPixel() const { return spp_; }
+  // Samples per pixel one path-tracing dispatch traces (pathtrace.comp's flat bounce loop, path
+  // regeneration): settings().samplesPerDispatch or the default, lowered so that K * (depth cap +
+  // alpha pass-throughs) <= kRegenBounceBudget; 1 in the Whitted and raster modes. A render loop
+  // should ask for passes of at least this many samples, or the dispatches trace fewer.
+  int samplesPerDispatch() const;
   // Reads back both accumulation images and the sample counters (for checkpoints).
   AccumulationState saveAccumulation() const;
   // Continues from `state` (saved from a renderer with the same scene and settings): the next pass

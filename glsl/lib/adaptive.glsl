@@ -1,5 +1,5 @@
 // adaptive.glsl — which pixel an invocation renders: the rows of FrameParams.tile (uniform passes), or
-// under adaptive sampling a live tile (side options.w: 1-8 pixels) read from the tile list (CAUSTICA_IMAGE_TILES).
+// under adaptive sampling a live tile (side listed.x: 1-8 pixels) read from the tile list (CAUSTICA_IMAGE_TILES).
 
 layout(r32ui, binding = CAUSTICA_IMAGE_TILES) uniform restrict readonly uimage2D tileList;
 
@@ -13,7 +13,7 @@ bool dispatchedPixel(out uvec2 pixel) {
   }
   // Adaptive: each work group samples 64 / side^2 consecutive entries of the tile list, side^2
   // invocations per tile (side 8: one tile, the invocation's local position in it).
-  uint side = frame.options.w;
+  uint side = frame.listed.x;
   uint perTile = side * side;
   uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;  // 2D grid past 65535 groups
   uint index = group * (uint(CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y) / perTile) + gl_LocalInvocationIndex / perTile;

@@ -7,7 +7,9 @@ layout(r32f, binding = CAUSTICA_IMAGE_COVERAGE) uniform restrict image2D coverag
 
 bool gCameraRayMissed = false;  // this invocation's camera ray left the scene (set by the tracer)
 
-// Adds hit (0 or 1) to the pixel's coverage count. Exact in float up to 2^24 samples per pixel.
-void accumulateCoverage(ivec2 pixel, float hit) {
-  imageStore(coverageImage, pixel, imageLoad(coverageImage, pixel) + vec4(hit, 0.0, 0.0, 0.0));
-}
+// The pixel's coverage count (samples whose camera ray hit). Exact in float up to 2^24 samples per pixel.
+float loadCoverage(ivec2 pixel) { return imageLoad(coverageImage, pixel).r; }
+void storeCoverage(ivec2 pixel, float hits) { imageStore(coverageImage, pixel, vec4(hits, 0.0, 0.0, 0.0)); }
+
+// Adds hit (0 or 1) to the pixel's coverage count.
+void accumulateCoverage(ivec2 pixel, float hit) { storeCoverage(pixel, loadCoverage(pixel) + hit); }

@@ -229,10 +229,11 @@ struct FrameParams {
   vec4 camForward;  // xyz: unit viewing direction
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
   uvec4 options;    // x: max depth, y: live tiles in the tile list (0: the dispatch covers `tile`; else one
-                    //    8x8 work group per 64 / w^2 listed tiles, adaptive sampling), z: emitter count, w: side of
-                    //    the listed tiles in pixels (1, 2, 4 or 8; the integrator and dispersion mode are shader
-                    //    variants, not flags)
+                    //    8x8 work group per 64 / side^2 listed tiles, adaptive sampling), z: emitter count, w: samples per pixel
+                    //    of this dispatch (pathtrace.comp; indices z .. z + w - 1; the integrator and dispersion
+                    //    mode are shader variants, not flags)
   uvec4 tile;       // x, y: pixel offset of this dispatch's tile; z, w: tile size
+  uvec4 listed;     // x: side of the listed tiles in pixels (1, 2, 4 or 8; adaptive.glsl), yzw unused
   // (A vec4 `lights`, the total emitter weight, was uploaded here and read by no shader since the light
   // tree: removed.)
 };
@@ -303,7 +304,7 @@ static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
 static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
 static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
-static_assert(sizeof(FrameParams) == 112, "FrameParams must be 112 bytes (std140)");
+static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
 static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
 static_assert(sizeof(LightNode) == 64, "LightNode must be 64 bytes (std430)");
 }  // namespace caustica::gpu

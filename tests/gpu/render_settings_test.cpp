@@ -28,6 +28,13 @@ TEST_CASE("render settings: defaults are valid, each bound is checked") {
   CHECK_THROWS_AS(s.validate(), Error);
   s.width = kMaxImageSide + 1;
   CHECK_THROWS_AS(s.validate(), Error);
+  s = RenderSettings{};
+  s.samplesPerDispatch = kMaxSamplesPerDispatch;
+  CHECK_NOTHROW(s.validate());
+  s.samplesPerDispatch = kMaxSamplesPerDispatch + 1;
+  CHECK_THROWS_WITH_AS(s.validate(), "samples per dispatch must be between 0 (automatic) and 64", Error);
+  s.samplesPerDispatch = -1;
+  CHECK_THROWS_AS(s.validate(), Error);
 }
 
 TEST_CASE("render settings: what each change asks of the renderer") {
@@ -81,6 +88,13 @@ TEST_CASE("render settings: what each change asks of the renderer") {
   c = compareSettings(a, b);
   CHECK((c.restart && c.shader));
   CHECK_FALSE((c.resize || c.casters));
+
+  // Samples per dispatch: the same image, but a change still restarts (like every change).
+  b = a;
+  b.samplesPerDispatch = 2;
+  c = compareSettings(a, b);
+  CHECK(c.restart);
+  CHECK_FALSE((c.resize || c.casters || c.shader));
 }
 
 TEST_CASE("render settings: names round-trip and unknown names are refused") {
