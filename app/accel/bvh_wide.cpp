@@ -59,7 +59,9 @@ BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
     int stackBefore;           // stack entries the traversal may hold on arriving here
   };
   std::vector<Work> work{{0, 0, 1, 0}};
-  out.nodes.reserve(binary.size() / 2 + 1);
+  // Every wide node starts from a distinct binary node, so binary.size() bounds the count: reserved
+  // once (address space only; untouched pages cost no memory), the vector never reallocates.
+  out.nodes.reserve(binary.size());
   while (!work.empty()) {
     const Work w = work.back();
     work.pop_back();

@@ -109,7 +109,10 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   // Flat scenes trace through the 4-wide nodes only (traverse.glsl), so the binary node buffer keeps
   // just the root there (~32 B per triangle less on the GPU). Instanced scenes trace the binary
   // two-level BVH (nodes, then instance records) and get an empty wide tree.
-  if (!instanced) g.nodes.resize(std::min<std::size_t>(g.nodes.size(), 1));
+  if (!instanced) {  // released, not only resized: the binary nodes' memory is free before the upload
+    std::vector<gpu::BvhNode> root(g.nodes.begin(), g.nodes.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(g.nodes.size()), 1));
+    g.nodes.swap(root);
+  }
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
   gpuBytes_.nodes += wideNodes.size() * sizeof(gpu::BvhWideNode);
