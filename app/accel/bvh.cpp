@@ -801,6 +801,27 @@ bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const
   return true;
 }
 
+bool intersectLeaf(const std::vector<gpu::TriGeom>& tris, std::uint32_t ref, const glm::vec3& origin,
+                   const RayShear& rs, bool anyHit, float& closest, Hit& hit) {
+  const std::uint32_t first = ref & gpu::kBvhFirstMask;
+  const std::uint32_t count = (ref >> gpu::kBvhCountShift) & 15u;
+  bool found = false;
+  for (std::uint32_t i = first; i < first + count; ++i) {
+    const gpu::TriGeom& g = tris[i];
+    float t, u, v;
+    if (intersectTriangleSheared(origin, rs, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u, v)) {
+      closest = t;
+      hit.t = t;
+      hit.u = u;
+      hit.v = v;
+      hit.tri = i;
+      found = true;
+      if (anyHit) break;
+    }
+  }
+  return found;
+}
+
 bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
                        float tmax, float& t, float& u, float& v) {
   return intersectTriangleSheared(ray.origin, makeRayShear(ray.dir), p0, p1, p2, tmax, t, u, v);
@@ -854,20 +875,7 @@ Hit traverse(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriG
         continue;
       }
     } else {
-      const std::uint32_t first = ref & gpu::kBvhFirstMask;
-      const std::uint32_t count = (ref >> gpu::kBvhCountShift) & 15u;
-      for (std::uint32_t i = first; i < first + count; ++i) {
-        const gpu::TriGeom& g = tris[i];
-        float t, u, v;
-        if (intersectTriangleSheared(ray.origin, rs, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u, v)) {
-          closest = t;
-          hit.t = t;
-          hit.u = u;
-          hit.v = v;
-          hit.tri = i;
-          if (kAnyHit) return hit;
-        }
-      }
+      if (intersectLeaf(tris, ref, ray.origin, rs, kAnyHit, closest, hit) && kAnyHit) return hit;
     }
     ref = pop();
     if (ref == gpu::kInvalidIndex) break;

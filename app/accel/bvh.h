@@ -73,6 +73,12 @@ RayShear makeRayShear(const glm::vec3& dir);
 bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const glm::vec3& p0, const glm::vec3& p1,
                               const glm::vec3& p2, float tmax, float& t, float& u, float& v);
 
+// The triangles of one leaf (`ref`: first | count << kBvhCountShift) against a sheared ray, as the C++
+// traversals (one-level, 4-wide, two-level) test a leaf: each hit nearer than `closest` becomes `hit`
+// and the new `closest`; with anyHit the first hit ends the test. Returns whether any triangle was hit.
+bool intersectLeaf(const std::vector<gpu::TriGeom>& tris, std::uint32_t ref, const glm::vec3& origin,
+                   const RayShear& rs, bool anyHit, float& closest, Hit& hit);
+
 // Watertight ray-triangle test (Woop, Benthin, Wald 2013). Twin of intersectTriangle() in intersect.glsl.
 // Returns true and fills t,u,v when the ray hits with 0 < t < tmax.
 bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,

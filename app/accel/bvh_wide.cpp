@@ -192,21 +192,7 @@ Hit traverseWide(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<g
         continue;
       }
     } else {
-      const std::uint32_t first = ref & gpu::kBvhFirstMask;
-      const std::uint32_t count = (ref >> gpu::kBvhCountShift) & 15u;
-      for (std::uint32_t i = first; i < first + count; ++i) {
-        const gpu::TriGeom& g = tris[i];
-        float t, u, v;
-        if (intersectTriangleSheared(ray.origin, rs, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u,
-                                     v)) {
-          closest = t;
-          hit.t = t;
-          hit.u = u;
-          hit.v = v;
-          hit.tri = i;
-          if (kAnyHit) return hit;
-        }
-      }
+      if (intersectLeaf(tris, ref, ray.origin, rs, kAnyHit, closest, hit) && kAnyHit) return hit;
     }
     ref = pop();
     if (ref == gpu::kInvalidIndex) break;

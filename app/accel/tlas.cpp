@@ -87,19 +87,9 @@ InstancedHit traverse(const InstancedBvh& bvh, const Ray& ray, float tmax) {
         ref = r.root;
         continue;
       }
-      const std::uint32_t count = (ref >> gpu::kBvhCountShift) & 15u;
-      for (std::uint32_t i = first; i < first + count; ++i) {
-        const gpu::TriGeom& g = bvh.tris[i];
-        float t, u, v;
-        if (intersectTriangleSheared(org, rs, glm::vec3(g.v0), glm::vec3(g.v1), glm::vec3(g.v2), closest, t, u, v)) {
-          closest = t;
-          out.hit.t = t;
-          out.hit.u = u;
-          out.hit.v = v;
-          out.hit.tri = i;
-          out.instance = bvh.instances[instRecord].sceneInstance;
-          if (kAnyHit) return out;
-        }
+      if (intersectLeaf(bvh.tris, ref, org, rs, kAnyHit, closest, out.hit)) {
+        out.instance = bvh.instances[instRecord].sceneInstance;
+        if (kAnyHit) return out;
       }
     }
     ref = pop();
