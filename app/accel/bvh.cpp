@@ -479,17 +479,17 @@ void buildSubtree(const BuildContext& ctx, const WorkItem& root, std::vector<gpu
 
 }  // namespace
 
-Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
+Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options) {
   if (options.bins < 2 || options.bins > kMaxBins)
     throw Error("bvh.cpp: BvhBuildOptions::bins must be in [2, " + std::to_string(kMaxBins) + "]");
   if (options.maxLeafSize < 1 || options.maxLeafSize > int(gpu::kBvhMaxLeafSize))
     throw Error("bvh.cpp: BvhBuildOptions::maxLeafSize must be in [1, " + std::to_string(gpu::kBvhMaxLeafSize) + "]");
   if (options.threads < 0) throw Error("bvh.cpp: BvhBuildOptions::threads must be >= 0");
-  if (triangles.size() > std::size_t(gpu::kBvhFirstMask))
-    throw Error("bvh.cpp: too many triangles (" + std::to_string(triangles.size()) + ")");
+  if (count > std::size_t(gpu::kBvhFirstMask))
+    throw Error("bvh.cpp: too many triangles (" + std::to_string(count) + ")");
 
   Bvh bvh;
-  const std::uint32_t n = std::uint32_t(triangles.size());
+  const std::uint32_t n = std::uint32_t(count);
   gpu::BvhNode emptyRoot{};  // a root of two empty slots (inverted boxes)
   emptyRoot.lmin = emptyRoot.rmin = glm::vec3(kInf);
   emptyRoot.lmax = emptyRoot.rmax = glm::vec3(-kInf);
@@ -658,6 +658,10 @@ Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& opti
   for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
   return bvh;
 }
+
+Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
+  return buildBvh(triangles.data(), triangles.size(), options);
+}
 bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3& hi) {
   lo = glm::vec3(kInf);
   hi = glm::vec3(-kInf);
@@ -710,17 +714,23 @@ double bvhSahCost(const std::vector<gpu::BvhNode>& nodes, float costTraversal, f
   return cost;
 }
 
-std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh) {
-  if (bvh.order.size() != triangles.size())
+void appendTriGeom(const Triangle* triangles, std::size_t count, const Bvh& bvh, std::vector<gpu::TriGeom>& out) {
+  if (bvh.order.size() != count)
     throw Error("bvh.cpp: BVH was built for " + std::to_string(bvh.order.size()) + " triangles, got " +
-                std::to_string(triangles.size()));
-  std::vector<gpu::TriGeom> out(triangles.size());
-  for (std::size_t i = 0; i < out.size(); ++i) {
+                std::to_string(count));
+  const std::size_t base = out.size();
+  out.resize(base + count);
+  for (std::size_t i = 0; i < count; ++i) {
     const Triangle& t = triangles[bvh.order[i]];
-    out[i].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
-    out[i].v1 = glm::vec4(t.p[1], 0.0f);
-    out[i].v2 = glm::vec4(t.p[2], 0.0f);
+    out[base + i].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
+    out[base + i].v1 = glm::vec4(t.p[1], 0.0f);
+    out[base + i].v2 = glm::vec4(t.p[2], 0.0f);
   }
+}
+
+std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh) {
+  std::vector<gpu::TriGeom> out;
+  appendTriGeom(triangles.data(), triangles.size(), bvh, out);
   return out;
 }
 

@@ -35,6 +35,8 @@ struct Bvh {
 // The result does not depend on BvhBuildOptions::threads (bit for bit).
 // Throws caustica::Error if the tree would be deeper than the GPU traversal stack allows.
 Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options = {});
+// The same over `count` triangles at `triangles` (a mesh's range of Scene::triangles, without a copy).
+Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options = {});
 
 // World-space bounds of everything under the root (both children's boxes); false for an empty tree.
 bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3& hi);
@@ -46,6 +48,8 @@ double bvhSahCost(const std::vector<gpu::BvhNode>& nodes, float costTraversal = 
 
 // Packs triangle positions in BVH leaf order (TriGeom.v0.w carries the material index bits).
 std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh);
+// packTriGeom of `count` triangles at `triangles`, appended to `out`.
+void appendTriGeom(const Triangle* triangles, std::size_t count, const Bvh& bvh, std::vector<gpu::TriGeom>& out);
 
 struct Ray {
   glm::vec3 origin{0.0f};

@@ -108,14 +108,15 @@ InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& option
   std::vector<std::uint32_t> triOffset(scene.meshes.size());
   std::vector<glm::vec3> meshMin(scene.meshes.size()), meshMax(scene.meshes.size());
   int meshDepth = 0;
+  out.tris.reserve(scene.triangles.size());  // every stored triangle once
+  out.triSource.reserve(scene.triangles.size());
   for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
     const MeshRange& range = scene.meshes[m];
-    const std::vector<Triangle> tris(scene.triangles.begin() + range.firstTriangle,
-                                     scene.triangles.begin() + range.firstTriangle + range.triangleCount);
-    Bvh b = buildBvh(tris, options);
+    const Triangle* tris = scene.triangles.data() + range.firstTriangle;  // the mesh's range, not a copy
+    Bvh b = buildBvh(tris, range.triangleCount, options);
     meshDepth = std::max(meshDepth, b.depth);
     triOffset[m] = std::uint32_t(out.tris.size());
-    for (const gpu::TriGeom& g : packTriGeom(tris, b)) out.tris.push_back(g);
+    appendTriGeom(tris, range.triangleCount, b, out.tris);
     for (std::uint32_t o : b.order) out.triSource.push_back(range.firstTriangle + o);
     if (!bvhBounds(b.nodes, meshMin[m], meshMax[m])) meshMin[m] = meshMax[m] = glm::vec3(0.0f);
     meshNodes[m] = std::move(b.nodes);
