@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "brute_force.h"
 #include "scene/obj_mesh.h"
 #include "util/error.h"
 
@@ -55,22 +56,7 @@ Ray makeRay(glm::vec3 o, glm::vec3 d) {
   return r;
 }
 
-// Brute force over all triangles (same intersection routine; the reference for the traversal).
-Hit bruteClosest(const std::vector<gpu::TriGeom>& tris, const Ray& ray, float tmax) {
-  Hit best;
-  float closest = tmax;
-  for (std::uint32_t i = 0; i < tris.size(); ++i) {
-    float t, u, v;
-    if (intersectTriangle(ray, glm::vec3(tris[i].v0), glm::vec3(tris[i].v1), glm::vec3(tris[i].v2), closest, t, u, v)) {
-      closest = t;
-      best.t = t;
-      best.u = u;
-      best.v = v;
-      best.tri = i;
-    }
-  }
-  return best;
-}
+using test::bruteClosest;  // brute_force.h
 
 // Traces every ray with the BVH and by brute force; returns the number of disagreements (closest hit
 // found/t/u/v, and traceOccluded against brute-force any-hit at a few tmax values).

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "brute_force.h"
 #include "accel/bvh_wide.h"
 #include "scene/obj_mesh.h"
 
@@ -40,21 +41,7 @@ Ray makeRay(glm::vec3 o, glm::vec3 d) {
   return r;
 }
 
-Hit bruteClosest(const std::vector<gpu::TriGeom>& tris, const Ray& ray, float tmax) {
-  Hit best;
-  float closest = tmax;
-  for (std::uint32_t i = 0; i < tris.size(); ++i) {
-    float t, u, v;
-    if (intersectTriangle(ray, glm::vec3(tris[i].v0), glm::vec3(tris[i].v1), glm::vec3(tris[i].v2), closest, t, u, v)) {
-      closest = t;
-      best.t = t;
-      best.u = u;
-      best.v = v;
-      best.tri = i;
-    }
-  }
-  return best;
-}
+using test::bruteClosest;  // brute_force.h
 
 // Half random rays through an enlarged bounding box, half aimed at points on random triangles; every
 // 13th axis-aligned with exact zeros.
