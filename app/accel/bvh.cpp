@@ -839,7 +839,7 @@ bool intersectTriangle(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
 
 namespace {
 
-using raybox::intersectAabb;
+using raybox::bvhVisitNode;
 using raybox::kBoxPad;
 using raybox::safeInverse;
 
@@ -870,18 +870,17 @@ Hit traverse(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriG
   for (;;) {
     if ((ref & gpu::kBvhLeafBit) == 0) {
       const gpu::BvhNode& node = nodes[ref];
-      float tl, tr;
-      const bool hl = intersectAabb(ray.origin, invDir, node.lmin, node.lmax, closest, tl);
-      const bool hr = intersectAabb(ray.origin, invDir, node.rmin, node.rmax, closest, tr);
-      const bool leftFirst = hl && (!hr || tl <= tr);
+      std::uint32_t near, far;
+      float farT;
+      const int hits = bvhVisitNode(node, ray.origin, invDir, closest, near, far, farT);
       // The builder bounds the depth, so the stack never overflows; the guard only protects memory.
-      if (hl && hr && sp < CAUSTICA_BVH_STACK) {
-        stackRef[sp] = leftFirst ? node.right : node.left;
-        stackT[sp] = leftFirst ? tr : tl;
+      if (hits == 2 && sp < CAUSTICA_BVH_STACK) {
+        stackRef[sp] = far;
+        stackT[sp] = farT;
         ++sp;
       }
-      if (hl || hr) {
-        ref = leftFirst ? node.left : node.right;
+      if (hits > 0) {
+        ref = near;
         continue;
       }
     } else {

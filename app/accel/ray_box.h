@@ -1,11 +1,15 @@
-// ray_box.h — the ray/box guards shared by the one- and two-level C++ traversals (bvh.cpp, tlas.cpp).
+// ray_box.h — the ray/box guards and the binary node visit shared by the one- and two-level C++ traversals
+// (bvh.cpp, tlas.cpp).
 // Twins of safeInverse() and intersectAabb() in glsl/lib/intersect.glsl; distances in units of |dir|.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <glm/glm.hpp>
+
+#include "shared/gpu_layout.h"
 
 namespace caustica::raybox {
 
@@ -37,6 +41,21 @@ inline bool intersectAabb(const glm::vec3& org, const glm::vec3& invDir, const g
   tnear = std::max(std::max(lo.x, lo.y), std::max(lo.z, 0.0f));
   const float tfar = std::min(std::min(hi.x, hi.y), std::min(hi.z, tmax)) * kBoxPad;
   return tnear <= tfar;
+}
+
+// One binary node's two child boxes against the ray (world or object space; t in units of |dir|):
+// `near` is the child to visit next, `far` (entry distance `farT`) the other; returns how many were
+// entered (0, 1: only `near`, or 2). Twin of bvhVisitNode() in glsl/lib/traverse.glsl.
+inline int bvhVisitNode(const gpu::BvhNode& node, const glm::vec3& org, const glm::vec3& invDir, float tmax,
+                        std::uint32_t& near, std::uint32_t& far, float& farT) {
+  float tl, tr;
+  const bool hl = intersectAabb(org, invDir, node.lmin, node.lmax, tmax, tl);
+  const bool hr = intersectAabb(org, invDir, node.rmin, node.rmax, tmax, tr);
+  const bool leftFirst = hl && (!hr || tl <= tr);
+  near = leftFirst ? node.left : node.right;
+  far = leftFirst ? node.right : node.left;
+  farT = leftFirst ? tr : tl;
+  return int(hl) + int(hr);
 }
 
 }  // namespace caustica::raybox

@@ -12,7 +12,7 @@ namespace caustica {
 
 namespace {
 
-using raybox::intersectAabb;
+using raybox::bvhVisitNode;
 using raybox::kBoxPad;
 using raybox::safeInverse;
 constexpr int kStack = 2 * CAUSTICA_BVH_STACK;  // one tree on top of the other
@@ -57,17 +57,16 @@ InstancedHit traverse(const InstancedBvh& bvh, const Ray& ray, float tmax) {
   for (;;) {
     if ((ref & gpu::kBvhLeafBit) == 0) {
       const gpu::BvhNode& node = bvh.nodes[ref];
-      float tl, tr;
-      const bool hl = intersectAabb(org, invDir, node.lmin, node.lmax, closest, tl);
-      const bool hr = intersectAabb(org, invDir, node.rmin, node.rmax, closest, tr);
-      const bool leftFirst = hl && (!hr || tl <= tr);
-      if (hl && hr && sp < std::uint32_t(kStack)) {
-        stackRef[sp] = leftFirst ? node.right : node.left;
-        stackT[sp] = leftFirst ? tr : tl;
+      std::uint32_t near, far;
+      float farT;
+      const int hits = bvhVisitNode(node, org, invDir, closest, near, far, farT);
+      if (hits == 2 && sp < std::uint32_t(kStack)) {
+        stackRef[sp] = far;
+        stackT[sp] = farT;
         ++sp;
       }
-      if (hl || hr) {
-        ref = leftFirst ? node.left : node.right;
+      if (hits > 0) {
+        ref = near;
         continue;
       }
     } else if (ref != gpu::kBvhEmptyRef) {
