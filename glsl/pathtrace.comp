@@ -172,7 +172,7 @@ bool pathBounce(inout PathState s) {
     vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
     if (dot(ns, ngFront) < 0.0) ns = -ns;
     vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
-    Material m = materials[floatBitsToUint(g.v0.w)];
+    Material m = materialAt(floatBitsToUint(g.v0.w));
 #ifdef CAUSTICA_TEXTURES
     ns = applyNormalMap(m, ns, uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
 #endif

@@ -121,6 +121,10 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
                              buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path, wideNodes);
   std::vector<gpu::BvhWideNode>().swap(wideNodes);
+  shadingTextures_ = ShadingTextures(buffers_[CAUSTICA_BINDING_MATERIALS], buffers_[CAUSTICA_BINDING_EMITTERS],
+                                     buffers_[CAUSTICA_BINDING_TEXELS],
+                                     bufferLayout_.triShade.parts == 1 ? &buffers_[CAUSTICA_BINDING_TRISHADE] : nullptr,
+                                     scene.path);
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
@@ -372,6 +376,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
   environment_.bind();
   bvhTextures_.bind();
+  shadingTextures_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);

@@ -1,5 +1,5 @@
-// textures.glsl — bilinear lookup of RGBA8 sRGB textures stored in one SSBO (see TexInfo in
-// gpu_layout.h). Texels are decoded to linear before filtering. uv in glTF convention (v down).
+// textures.glsl — bilinear lookup of RGBA8 sRGB textures stored in one buffer, read as a buffer texture
+// (see TexInfo in gpu_layout.h). Texels are decoded to linear before filtering. uv in glTF convention (v down).
 
 vec3 srgbToLinear(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
@@ -21,7 +21,7 @@ vec4 fetchTexel(TexInfo info, int x, int y, bool srgb) {
   uint w = info.width, h = info.height;
   x = wrapCoord(x, int(w), (info.flags & 1u) != 0u, (info.flags & 4u) != 0u);
   y = wrapCoord(y, int(h), (info.flags & 2u) != 0u, (info.flags & 8u) != 0u);
-  vec4 c = unpackUnorm4x8(texels[info.offset + uint(y) * w + uint(x)]);
+  vec4 c = unpackUnorm4x8(texelFetch(texelWords, int(info.offset + uint(y) * w + uint(x))).x);
   return srgb ? vec4(srgbToLinear(c.rgb), c.a) : c;
 }
 

@@ -87,7 +87,7 @@ vec3 sampleEmitterLight(Vertex v, inout uvec4 rng, inout uint shadowRays) {
   transmittance = exp(-(above ? v.sigmaAbove : v.sigmaBelow) * dist);  // the medium the shadow ray runs in
 #endif
 #ifdef CAUSTICA_SPOT_EMITTERS
-  ls.le *= spotEmitterFactor(materials[ls.material], -wl);  // a --light-radius spot sphere emits into its cone
+  ls.le *= spotEmitterFactor(materialAt(ls.material), -wl);  // a --light-radius spot sphere emits into its cone
 #endif
   return f * (w / pdfLight) * ls.le * transmittance;
 }
