@@ -184,7 +184,7 @@ bool pathBounce(inout PathState s) {
 #ifdef CAUSTICA_SPOT_EMITTERS
       w *= spotEmitterFactor(m, -s.dir);  // a --light-radius sphere of a spot light emits into its cone
 #endif
-#ifdef CAUSTICA_MIS
+#if defined(CAUSTICA_MIS) && !defined(CAUSTICA_NO_EMITTERS)
       if (!s.prevDelta) {
 #ifdef CAUSTICA_INSTANCED
         float pdfLight = instanceLightPdfArea(g, xf, s.prevP, s.prevN) * hit.t * hit.t / max(abs(dot(ngFront, s.dir)), 1.0e-12);

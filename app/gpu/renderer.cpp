@@ -187,6 +187,9 @@ std::vector<std::string> Renderer::shaderDefines() const {
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
+    // No emissive triangles (mis for the environment alone): the emitter estimate and the emitter-hit
+    // pdf are left out rather than run masked on every bounce (llvmpipe runs every branch; vertex.glsl).
+    if (gpuScene_.emitters.empty() && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
   }
   if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
