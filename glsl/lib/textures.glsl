@@ -40,10 +40,12 @@ vec4 sampleTextureAs(uint index, vec2 uv, bool srgb) {
   // Keep the coordinate bounded before converting to int (huge uv would overflow).
   vec2 st = uv * vec2(float(info.width), float(info.height));
   st = clamp(st, vec2(-1.0e7), vec2(1.0e7));
-  if ((info.flags & 16u) != 0u) return fetchTexel(info, int(floor(st.x)), int(floor(st.y)), srgb);
-  st -= 0.5;
-  vec2 f = fract(st);
-  int x0 = int(floor(st.x)), y0 = int(floor(st.y));
+  // Nearest filtering is the bilinear sum with zero weights on the neighbours (exact: mix(a, b, 0.0) = a
+  // for finite texels), so both filters share one path: llvmpipe would run a separate nearest path too.
+  bool nearest = (info.flags & 16u) != 0u;
+  vec2 s0 = nearest ? st : st - 0.5;
+  vec2 f = nearest ? vec2(0.0) : fract(s0);
+  int x0 = int(floor(s0.x)), y0 = int(floor(s0.y));
   vec4 a = mix(fetchTexel(info, x0, y0, srgb), fetchTexel(info, x0 + 1, y0, srgb), f.x);
   vec4 b = mix(fetchTexel(info, x0, y0 + 1, srgb), fetchTexel(info, x0 + 1, y0 + 1, srgb), f.x);
   return mix(a, b, f.y);
