@@ -5,24 +5,7 @@ vec3 srgbToLinear(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
 }
 
-// i mod n in [0, n) (floored), without an integer division: SIMD hardware has none (llvmpipe divides
-// lane by lane, 8 scalar divisions per call). |i| <= 1e7 + 1 and n < 2^24 are exact floats, so the float
-// quotient's floor is off by at most one, which the two corrections undo: the same result as
-// ((i % n) + n) % n.
-int floorMod(int i, int n) {
-  int m = i - n * int(floor(float(i) / float(n)));
-  m += m < 0 ? n : 0;
-  m -= m >= n ? n : 0;
-  return m;
-}
-
-// Texel index i wrapped into [0, n): mirrored repeat (taking precedence), repeat, or clamp to the edge.
-int wrapCoord(int i, int n, bool repeat, bool mirror) {
-  if (!repeat && !mirror) return clamp(i, 0, n - 1);
-  int period = mirror ? 2 * n : n;
-  int m = floorMod(i, period);
-  return mirror && m >= n ? period - 1 - m : m;
-}
+#include "texture_wrap.glsl"  // wrapCoord
 
 // srgb: colour textures (base colour, emission) are sRGB-encoded; data textures (metallicRoughness,
 // normal) are linear and are read as stored.
