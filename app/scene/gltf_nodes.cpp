@@ -441,6 +441,15 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
   const std::vector<double> normals = readAttribute(
       prim, "NORMAL", TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, vertexCount, at);
+  // Each vertex's world-space normal as its octahedral word (Triangle::normalWord), encoded once per
+  // vertex rather than once per corner (a closed mesh has ~6 corners per vertex); kOctNoNormal marks
+  // a zero or non-finite one (octEncode never gives it for a unit vector).
+  std::vector<std::uint32_t> normalWords(normals.empty() ? 0 : vertexCount);
+  for (std::size_t i = 0; i < normalWords.size(); ++i) {
+    const glm::dvec3 nw = xf.normal * glm::dvec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    const double len = glm::length(nw);
+    normalWords[i] = !(len > 1e-20) || !std::isfinite(len) ? kOctNoNormal : octEncode(glm::vec3(nw / len));
+  }
 
   std::vector<std::uint32_t> indices;
   if (prim.indices >= 0) {
@@ -529,21 +538,18 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       ++degenerate_;
       continue;
     }
-    const glm::vec3 flat = cross / area2;
-    bool smooth = !normals.empty();
+    bool smooth = !normalWords.empty();
     for (int k = 0; k < 3 && smooth; ++k) {
-      const std::size_t i = v[k];
-      const glm::dvec3 nw = xf.normal * glm::dvec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
-      const double len = glm::length(nw);
-      if (!(len > 1e-20) || !std::isfinite(len)) {
+      tri.normalWord[k] = normalWords[v[k]];
+      if (tri.normalWord[k] == kOctNoNormal) {
         smooth = false;
         ++badNormals_;
-      } else {
-        tri.setNormal(k, glm::vec3(nw / len));
       }
     }
-    if (!smooth)
-      for (int k = 0; k < 3; ++k) tri.setNormal(k, flat);
+    if (!smooth) {
+      tri.setNormal(0, cross / area2);  // flat
+      tri.normalWord[1] = tri.normalWord[2] = tri.normalWord[0];
+    }
     scene_.triangles.push_back(tri);
     if (keepUv_) scene_.texcoords.push_back(uv);
   }
