@@ -216,7 +216,7 @@ bool pathBounce(inout PathState s) {
     // whichever lobe the lanes took. The non-delta lobes (Lambertian and GGX) therefore share one
     // vertex and one call of each next-event estimate; each lobe draws its random numbers in the same
     // order as before (its own ones first, then the lights', then its direction), so images are
-    // unchanged (docs/benchmarks.md, "One call site per light estimate").
+    // unchanged (docs/benchmarks.md, "Session 5").
     bool diffuse = lobe == kLobeDiffuse;
 #ifdef CAUSTICA_GGX
     bool glossy = lobe >= kLobeConductor;  // GGX lobes: rough metal, plastic, rough glass (microfacet.glsl)
