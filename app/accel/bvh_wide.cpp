@@ -122,8 +122,6 @@ BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
 
 namespace {
 
-using raybox::kBoxPad;
-
 // The four children's slab tests (intersectAabb per component, same operations as the GLSL's vec4
 // form), then a sort by entry distance (misses last at kMissT). Returns how many children the ray enters.
 int visitWide(const gpu::BvhWideNode& n, const glm::vec3& org, const glm::vec3& invDir, float tmax,
@@ -153,8 +151,8 @@ int visitWide(const gpu::BvhWideNode& n, const glm::vec3& org, const glm::vec3& 
 }
 
 // Shared by closest and any hit, in the GLSL twin's order: the nearest entered child next, the others
-// stacked nearest on top with their entry distances; a popped subtree that starts beyond the closest
-// hit is skipped (closest hit only).
+// stacked nearest on top (refs only, as the twin: a popped subtree beyond the closest hit is entered and
+// its node visit or leaf test finds nothing nearer, docs/benchmarks.md "Session 5").
 template <bool kAnyHit>
 Hit traverseWide(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriGeom>& tris, const Ray& ray,
                  float tmax) {
@@ -164,16 +162,9 @@ Hit traverseWide(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<g
   const RayShear rs = makeRayShear(ray.dir);
   float closest = tmax;
   std::uint32_t stackRef[CAUSTICA_BVH_WIDE_STACK];
-  float stackT[CAUSTICA_BVH_WIDE_STACK];
   std::uint32_t sp = 0;
   std::uint32_t ref = 0;  // the root, an inner node
-  auto pop = [&]() -> std::uint32_t {
-    while (sp > 0) {
-      --sp;
-      if (kAnyHit || stackT[sp] <= closest * kBoxPad) return stackRef[sp];
-    }
-    return gpu::kInvalidIndex;
-  };
+  auto pop = [&]() -> std::uint32_t { return sp > 0 ? stackRef[--sp] : gpu::kInvalidIndex; };
   for (;;) {
     if ((ref & gpu::kBvhLeafBit) == 0) {
       std::uint32_t r[4];
@@ -183,7 +174,6 @@ Hit traverseWide(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<g
       if (hits > 1 && sp + 3 <= CAUSTICA_BVH_WIDE_STACK) {
         for (int k = hits - 1; k >= 1; --k) {
           stackRef[sp] = r[k];
-          stackT[sp] = t[k];
           ++sp;
         }
       }

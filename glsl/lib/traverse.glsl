@@ -21,9 +21,10 @@
 // Loop shape (for SIMD drivers such as llvmpipe, which run 8 invocations in lock-step and execute both
 // sides of every branch): an inner loop descends through inner nodes until every lane holds a leaf,
 // then the lanes test their leaves' triangles together. At a wide node the entered children are sorted
-// by entry distance (a 5-exchange network): the nearest is visited next, the others stacked with their
-// entry distances, nearest on top — the same order as the C++ twin's, so ties between equal t resolve
-// the same way. A popped subtree whose entry distance is beyond the closest hit so far is skipped.
+// by entry distance (a 5-exchange network): the nearest is visited next, the others stacked (refs
+// only), nearest on top — the same order as the C++ twin's, so ties between equal t resolve the same
+// way. A popped subtree beyond the closest hit so far is not skipped on the stack: its node visit
+// enters none of its children (their boxes end before hit.t), so no distances are stacked.
 
 struct Hit {
   float t;   // distance along dir (units of |dir|)
@@ -137,10 +138,12 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   vec3 invDir = safeInverse(dir);
   RayShear rs = makeRayShear(dir);
 
-  // (ref, entry distance as float bits) in one array rather than two, and only the kept entries
-  // pushed: together ~10-15 % less CPU on llvmpipe than two arrays and three unconditional writes
-  // (docs/benchmarks.md, 4-wide BVH).
-  uvec2 stack[CAUSTICA_BVH_WIDE_STACK];
+  // Refs only, as in traceOccluded: a popped subtree is entered even when its entry distance is beyond
+  // the closest hit (bvhVisitWide then enters none of its children, or its leaf's triangles fail the
+  // t < hit.t test), so the hit is the same. On llvmpipe every indexed write of a local array is a
+  // loop over the 8 lanes at each call site, and a pop that skips far subtrees is a loop: one word per
+  // push instead of two and one gather per pop measured 1.02-1.10x faster (docs/benchmarks.md, Session 5).
+  uint stackRef[CAUSTICA_BVH_WIDE_STACK];
   uint sp = 0u;
   uint ref = 0u;  // the root, an inner node
   while (true) {
@@ -152,23 +155,16 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
       // Entered children 1..hits-1, farthest first so that child 1 ends on top (packBvhWideNodes
       // guarantees sp + 3 <= the stack size; the check only guards memory).
       if (hits > 1u && sp + 3u <= uint(CAUSTICA_BVH_WIDE_STACK)) {
-        uvec4 tb = floatBitsToUint(t);
-        if (hits == 4u) stack[sp++] = uvec2(r.w, tb.w);
-        if (hits >= 3u) stack[sp++] = uvec2(r.z, tb.z);
-        stack[sp++] = uvec2(r.y, tb.y);
+        if (hits == 4u) stackRef[sp++] = r.w;
+        if (hits >= 3u) stackRef[sp++] = r.z;
+        stackRef[sp++] = r.y;
       }
       if (hits > 0u) {
         ref = r.x;
+      } else if (sp > 0u) {
+        ref = stackRef[--sp];
       } else {
         ref = kBvhEmptyRef;
-        while (sp > 0u) {
-          --sp;
-          uvec2 e = stack[sp];
-          if (uintBitsToFloat(e.y) <= hit.t * kBvhBoxPad) {
-            ref = e.x;
-            break;
-          }
-        }
       }
     }
     uint first = ref & kBvhFirstMask;
@@ -184,17 +180,8 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
         hit.tri = i;
       }
     }
-    // Next: the nearest stacked subtree that can still hold a closer hit.
-    ref = kInvalidIndex;
-    while (sp > 0u) {
-      --sp;
-      uvec2 e = stack[sp];
-      if (uintBitsToFloat(e.y) <= hit.t * kBvhBoxPad) {
-        ref = e.x;
-        break;
-      }
-    }
-    if (ref == kInvalidIndex) break;
+    if (sp == 0u) break;
+    ref = stackRef[--sp];  // the nearest stacked subtree
   }
   return hit.tri != kInvalidIndex;
 }
