@@ -68,8 +68,7 @@ SceneFeatures sceneFeatures(const Scene& scene) {
     f.volume |= glass && std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f &&
                 glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
     f.dispersion |= glass && m.dispersion > 0.0f;
-    f.textures |= m.baseColorTexture >= 0 || m.emissiveTexture >= 0 || m.metallicRoughnessTexture >= 0 ||
-                  m.normalTexture >= 0;
+    f.textures |= m.readsTextures();
     f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture;
     f.ggx |= hasRoughLobe(m);
   }
@@ -155,11 +154,12 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
     // Shading words (gpu_layout.h): octahedral normals, then full-float texcoords only where textures
     // read them (half floats would move a texel on large textures).
     std::uint32_t* w = shade.data() + j * g.triShadeStride;
-    for (int k = 0; k < 3; ++k) w[k] = octEncode(t.n[k]);
+    for (int k = 0; k < 3; ++k) w[k] = t.normalWord[k];  // stored octahedral already (scene.h)
     if (g.triShadeStride == gpu::kTriShadeWordsTextured)
       for (int k = 0; k < 3; ++k) {
-        w[3 + 2 * k] = floatBits(t.uv[k].x);
-        w[4 + 2 * k] = floatBits(t.uv[k].y);
+        const glm::vec2 uv = triangleUv(scene, bvh.order[i], k);
+        w[3 + 2 * k] = floatBits(uv.x);
+        w[4 + 2 * k] = floatBits(uv.y);
       }
   }
 }
@@ -168,6 +168,8 @@ namespace {
 // What packScene and packInstancedScene share: features, environment, materials, punctual lights,
 // textures (not the triangles, the casters or the emitters).
 void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
+  if (!scene.texcoords.empty() && scene.texcoords.size() != scene.triangles.size())
+    throw Error("internal: Scene::texcoords is neither empty nor one per triangle");
   for (const Material& m : scene.materials) {
     gpu::Material gm{};
     gm.baseColor = m.baseColor;
@@ -317,11 +319,12 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     const Triangle& t = scene.triangles[i];
     g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
     std::uint32_t* w = g.triShade.data() + x * g.triShadeStride;
-    for (int k = 0; k < 3; ++k) w[k] = octEncode(t.n[k]);
+    for (int k = 0; k < 3; ++k) w[k] = t.normalWord[k];  // stored octahedral already (scene.h)
     if (g.triShadeStride == gpu::kTriShadeWordsTextured)
       for (int k = 0; k < 3; ++k) {
-        w[3 + 2 * k] = floatBits(t.uv[k].x);
-        w[4 + 2 * k] = floatBits(t.uv[k].y);
+        const glm::vec2 uv = triangleUv(scene, i, k);
+        w[3 + 2 * k] = floatBits(uv.x);
+        w[4 + 2 * k] = floatBits(uv.y);
       }
   }
 

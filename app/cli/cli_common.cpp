@@ -20,6 +20,7 @@
 #include "cli/environment_options.h"
 #include "scene/assets.h"
 #include "util/error.h"
+#include "util/memory_stats.h"
 
 namespace caustica::cli {
 
@@ -296,6 +297,7 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
   std::string path = resolveScenePath(nameOrPath);
   LoadedScene ls;
   ls.scene = loadScene(path, loadOptions);
+  releaseFreedMemory();  // the parser's arrays and the file's bytes: freed heap back to the kernel (memory_stats.h)
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
   if (opts.has("--light-radius")) {
     const double r = opts.getDouble("--light-radius", 0.0);

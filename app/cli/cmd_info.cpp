@@ -128,6 +128,7 @@ int cmdInfo(const std::vector<std::string>& args) {
                 g.casters[i].sphere.w);
   std::string defines;
   for (const auto& d : g.features.defines()) defines += " " + d;
+  for (const auto& d : g.instanceDefines()) defines += " " + d;  // the two-level traversal, as the renderer adds it
   std::printf("defines:   %s\n", defines.empty() ? " (none)" : defines.c_str());
   for (const auto& w : s.warnings) std::printf("warning:    %s\n", w.c_str());
   return 0;

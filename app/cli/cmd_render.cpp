@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "util/error.h"
 #include "util/file_io.h"
+#include "util/memory_stats.h"
 #include "image/image_io.h"
 #include "platform/context.h"
 
@@ -75,8 +76,10 @@ int cmdRender(const std::vector<std::string>& args) {
   const std::string resumePath = opts.get("--resume", "");
   if (opts.has("--resume")) resumeFrom = readCheckpoint(resumePath);  // a bad file fails before any work
 
+  memTrace("command start");
   const auto commandStart = std::chrono::steady_clock::now();
   LoadedScene ls = loadSceneForCli(opts, !quiet);
+  memTrace("scene loaded");
   const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
@@ -93,6 +96,7 @@ int cmdRender(const std::vector<std::string>& args) {
   }
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);
+  memTrace("context");
   note(quiet, "OpenGL (" + context->backendName() + "): " + glInfo);
   ShaderLibrary library = shaderLibraryFrom(opts);
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
@@ -122,6 +126,7 @@ int cmdRender(const std::vector<std::string>& args) {
   installInterruptHandlers();
   auto start = std::chrono::steady_clock::now();
   const BudgetResult result = renderWithBudget(renderer, budget, "", quiet, hooks);
+  memTrace("rendered");
   const bool complete = result.reason != StopReason::Interrupted;
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const RenderStats& st = renderer.stats();

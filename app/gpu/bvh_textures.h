@@ -11,6 +11,9 @@
 
 namespace caustica {
 
+// Throws Error naming `what` when `texels` (16-byte RGBA32UI texels) exceed GL_MAX_TEXTURE_BUFFER_SIZE.
+void checkBufferTextureTexels(std::size_t texels, const std::string& what);
+
 class BvhTextures {
  public:
   BvhTextures() = default;
@@ -20,6 +23,10 @@ class BvhTextures {
   // scene's path) when any has more texels than GL_MAX_TEXTURE_BUFFER_SIZE.
   BvhTextures(const GlBuffer& nodes, std::size_t nodeCount, const GlBuffer& triGeom, std::size_t triCount,
               const std::string& what, const std::vector<gpu::BvhWideNode>& wide = {});
+  // The same with the 4-wide nodes already in `wideBuffer` (`wideCount` nodes; none: an empty root), so
+  // that the caller can free its host copy before it uploads the rest (Renderer).
+  BvhTextures(const GlBuffer& nodes, std::size_t nodeCount, const GlBuffer& triGeom, std::size_t triCount,
+              const std::string& what, GlBuffer wideBuffer, std::size_t wideCount);
   // Binds them on CAUSTICA_TEXUNIT_BVH_NODES, CAUSTICA_TEXUNIT_TRI_GEOM and CAUSTICA_TEXUNIT_BVH_WIDE.
   void bind() const;
 

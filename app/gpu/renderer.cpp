@@ -11,6 +11,7 @@
 #include "accel/tlas.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
+#include "util/memory_stats.h"
 
 namespace caustica {
 
@@ -80,6 +81,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   };
   auto t0 = std::chrono::steady_clock::now();
   const bool instanced = !scene.instances.empty();
+  memTrace("renderer start");
   std::vector<gpu::BvhWideNode> wideNodes;  // what traverse.glsl reads in flat scenes
   if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
     InstancedBvh ib = buildInstancedBvh(scene);
@@ -89,6 +91,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     gpuScene_ = packInstancedScene(scene, ib);
   } else {
     bvh_ = buildBvh(scene.triangles);
+    memTrace("bvh built");
     bvhSeconds_ = load_.bvh = since(t0);
     t0 = std::chrono::steady_clock::now();
     std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
@@ -96,6 +99,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
     gpuScene_.nodes = std::move(nodes);
     wideNodes = packBvhWideNodes(gpuScene_.nodes).nodes;
+    memTrace("wide nodes");
   }
   load_.pack = since(t0);
 
@@ -117,10 +121,21 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   gpuBytes_ = gpuSceneBytes(g);
   gpuBytes_.nodes += wideNodes.size() * sizeof(gpu::BvhWideNode);
   t0 = std::chrono::steady_clock::now();
-  uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
-  bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
-                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path, wideNodes);
+  // The 4-wide nodes go up first and their host copy is freed before the triangle records' blocks are
+  // made, so the two copies of the nodes and the triangle blocks are never held at once (on llvmpipe
+  // the "GPU" copy is host memory: docs/big-scenes.md).
+  const std::size_t wideCount = wideNodes.size();
+  checkBufferTextureTexels(wideCount * (sizeof(gpu::BvhWideNode) / 16), scene.path);
+  GlBuffer wideBuffer = wideNodes.empty() ? GlBuffer() : GlBuffer::fromVector(wideNodes);
   std::vector<gpu::BvhWideNode>().swap(wideNodes);
+  releaseFreedMemory();  // the build's records and the binary nodes (glibc keeps freed heap otherwise)
+  memTrace("wide nodes uploaded");
+  uploadSceneBuffers(g, scene, bvh_, bufferLayout_, buffers_);  // frees g.nodes
+  memTrace("scene buffers uploaded");
+  bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
+                             buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path,
+                             std::move(wideBuffer), wideCount);
+  memTrace("bvh textures");
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
@@ -140,11 +155,13 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   environment_.upload(g, limits_, scene.path);
   glFinish();
   load_.upload = since(t0);
+  memTrace("upload done");
   transparent_ = g.environmentParams.size.z == gpu::kBackgroundTransparent;
   allocateImages();
   t0 = std::chrono::steady_clock::now();
   prepareMode();  // compile now, so shader errors surface before rendering starts
   load_.compile = since(t0);
+  memTrace("compiled");
   load_.ready = since(created_);
 }
 

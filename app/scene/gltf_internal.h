@@ -192,6 +192,7 @@ class SceneBuilder {
   // Transformed references (KHR_texture_transform): glTF texture index and rows -> Scene::textures index.
   std::map<std::pair<int, std::vector<float>>, int> transformMap_;
   int defaultMaterial_ = -1;
+  bool keepUv_ = false;          // some material reads a texture: Scene::texcoords kept (keepsTexcoords)
   std::size_t degenerate_ = 0;   // zero-area triangles dropped
   std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable
   std::size_t candidates_ = 0;   // triangles assembled so far, degenerate ones included

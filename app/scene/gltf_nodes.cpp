@@ -22,6 +22,7 @@ namespace caustica::gltf {
 void SceneBuilder::build() {
   warnUnsupportedExtensions();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
+  keepUv_ = keepsTexcoords(scene_.materials);  // the default material added later reads none
   traverse();
   if (options_.keepInstances && options_.autoInstances) options_.keepInstances = instancingPays();
   checkTriangleCount();
@@ -123,12 +124,13 @@ void SceneBuilder::checkTriangleCount() {
     }
   }
   // One allocation for every triangle: growing the vector by doubling held the old and the new array
-  // at once, 1.5x the triangles' 100 B at the peak. Only as many as the buffers can hold (a triangle
+  // at once, 1.5x the triangles' 52 B at the peak. Only as many as the buffers can hold (a triangle
   // takes at least 3 index bytes), so a file that declares more than it has fails later, as before.
   std::uint64_t bytes = 0;
   for (const tinygltf::Buffer& b : model_.buffers) bytes += b.data.size();
   try {
     scene_.triangles.reserve(scene_.triangles.size() + static_cast<std::size_t>(std::min(total, bytes / 3)));
+    if (keepUv_) scene_.texcoords.reserve(scene_.triangles.capacity());
   } catch (const std::exception&) {  // bad_alloc, length_error: grow as needed instead
   }
 }
@@ -439,6 +441,15 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
   const std::vector<double> normals = readAttribute(
       prim, "NORMAL", TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, vertexCount, at);
+  // Each vertex's world-space normal as its octahedral word (Triangle::normalWord), encoded once per
+  // vertex rather than once per corner (a closed mesh has ~6 corners per vertex); kOctNoNormal marks
+  // a zero or non-finite one (octEncode never gives it for a unit vector).
+  std::vector<std::uint32_t> normalWords(normals.empty() ? 0 : vertexCount);
+  for (std::size_t i = 0; i < normalWords.size(); ++i) {
+    const glm::dvec3 nw = xf.normal * glm::dvec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    const double len = glm::length(nw);
+    normalWords[i] = !(len > 1e-20) || !std::isfinite(len) ? kOctNoNormal : octEncode(glm::vec3(nw / len));
+  }
 
   std::vector<std::uint32_t> indices;
   if (prim.indices >= 0) {
@@ -510,6 +521,7 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     std::uint32_t v[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};
     if (xf.flip) std::swap(v[1], v[2]);  // negative determinant: restore counter-clockwise fronts
     Triangle tri;
+    TriangleUv uv;
     tri.material = material;
     bool finite = true;
     for (int k = 0; k < 3; ++k) {
@@ -517,7 +529,7 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       const glm::dvec4 p = xf.world * glm::dvec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0);
       tri.p[k] = glm::vec3(glm::dvec3(p) - origin_);
       finite = finite && std::isfinite(tri.p[k].x) && std::isfinite(tri.p[k].y) && std::isfinite(tri.p[k].z);
-      tri.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
+      uv.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
     }
     if (!finite) fail(at + ": a vertex position overflows a float after the node transform");
     const glm::vec3 cross = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
@@ -526,21 +538,20 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       ++degenerate_;
       continue;
     }
-    const glm::vec3 flat = cross / area2;
-    bool smooth = !normals.empty();
+    bool smooth = !normalWords.empty();
     for (int k = 0; k < 3 && smooth; ++k) {
-      const std::size_t i = v[k];
-      const glm::dvec3 nw = xf.normal * glm::dvec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
-      const double len = glm::length(nw);
-      if (!(len > 1e-20) || !std::isfinite(len)) {
+      tri.normalWord[k] = normalWords[v[k]];
+      if (tri.normalWord[k] == kOctNoNormal) {
         smooth = false;
         ++badNormals_;
-      } else {
-        tri.n[k] = glm::vec3(nw / len);
       }
     }
-    if (!smooth) tri.n[0] = tri.n[1] = tri.n[2] = flat;
+    if (!smooth) {
+      tri.setNormal(0, cross / area2);  // flat
+      tri.normalWord[1] = tri.normalWord[2] = tri.normalWord[0];
+    }
     scene_.triangles.push_back(tri);
+    if (keepUv_) scene_.texcoords.push_back(uv);
   }
 }
 

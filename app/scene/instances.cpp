@@ -15,7 +15,8 @@ namespace {
 // those of the wanted materials) to `out`, and to `source` (when given) the Scene::triangles index each
 // came from.
 void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangle>& out,
-                     std::vector<std::uint32_t>* source, const std::vector<bool>* materialWanted = nullptr) {
+                     std::vector<std::uint32_t>* source, const std::vector<bool>* materialWanted = nullptr,
+                     std::vector<TriangleUv>* outUv = nullptr) {
   const MeshRange& m = scene.meshes[in.mesh];
   const glm::dmat3 m3(in.world);
   const glm::dmat3 normal = glm::transpose(glm::inverse(m3));
@@ -24,21 +25,25 @@ void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangl
     const Triangle& src = scene.triangles[i];
     if (materialWanted && (src.material >= materialWanted->size() || !(*materialWanted)[src.material])) continue;
     Triangle t;
+    TriangleUv uv;
     t.material = src.material;
+    glm::vec3 n[3];
     for (int k = 0; k < 3; ++k) {
       const int s = flip && k > 0 ? 3 - k : k;  // swaps corners 1 and 2
       t.p[k] = glm::vec3(glm::dvec3(in.world * glm::dvec4(glm::dvec3(src.p[s]), 1.0)) - scene.origin);
-      const glm::dvec3 n = normal * glm::dvec3(src.n[s]);
-      const double len = glm::length(n);
-      t.n[k] = len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0.0f);
-      t.uv[k] = src.uv[s];
+      // The object-space normal as stored (octahedral, within 4.3e-5 rad of the file's), transformed.
+      const glm::dvec3 nw = normal * glm::dvec3(src.normal(s));
+      const double len = glm::length(nw);
+      n[k] = len > 0.0 && std::isfinite(len) ? glm::vec3(nw / len) : glm::vec3(0.0f);
+      uv.uv[k] = triangleUv(scene, i, s);
     }
     const glm::vec3 cross = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
     const float area2 = glm::length(cross);
     if (!(area2 > 0.0f) || !std::isfinite(area2)) continue;  // zero area in world space
-    if (t.n[0] == glm::vec3(0.0f) || t.n[1] == glm::vec3(0.0f) || t.n[2] == glm::vec3(0.0f))
-      t.n[0] = t.n[1] = t.n[2] = cross / area2;
+    if (n[0] == glm::vec3(0.0f) || n[1] == glm::vec3(0.0f) || n[2] == glm::vec3(0.0f)) n[0] = n[1] = n[2] = cross / area2;
+    for (int k = 0; k < 3; ++k) t.setNormal(k, n[k]);
     out.push_back(t);
+    if (outUv) outUv->push_back(uv);
     if (source) source->push_back(i);
   }
 }
@@ -47,11 +52,15 @@ void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangl
 void flattenInstances(Scene& scene) {
   if (scene.instances.empty()) return;
   std::vector<Triangle> out;
+  std::vector<TriangleUv> outUv;  // only where the scene keeps texture coordinates
+  const bool uv = !scene.texcoords.empty();
   std::size_t total = 0;
   for (const Instance& in : scene.instances) total += scene.meshes[in.mesh].triangleCount;
   out.reserve(total);
-  for (const Instance& in : scene.instances) flattenInstance(scene, in, out, nullptr);
+  if (uv) outUv.reserve(total);
+  for (const Instance& in : scene.instances) flattenInstance(scene, in, out, nullptr, nullptr, uv ? &outUv : nullptr);
   scene.triangles = std::move(out);
+  scene.texcoords = std::move(outUv);
   scene.meshes.clear();
   scene.instances.clear();
 }

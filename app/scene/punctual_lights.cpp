@@ -141,11 +141,12 @@ void applyLightRadius(Scene& scene, float radius) {
       Triangle t{};
       for (int k = 0; k < 3; ++k) {
         t.p[k] = l.position + radius * q[std::size_t(k)];
-        t.n[k] = q[std::size_t(k)];
+        t.setNormal(k, q[std::size_t(k)]);
         scene.bounds.grow(t.p[k]);
       }
       t.material = material;
       scene.triangles.push_back(t);
+      if (!scene.texcoords.empty()) scene.texcoords.emplace_back();  // (0, 0): the sphere reads no texture
     }
   }
   scene.punctualLights = std::move(kept);

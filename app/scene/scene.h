@@ -10,6 +10,7 @@
 
 #include "scene/environment.h"
 #include "scene/punctual_lights.h"
+#include "shading/oct_normal.h"
 
 namespace caustica {
 
@@ -58,18 +59,34 @@ struct Material {
   bool doubleSided = false;
 
   bool isEmissive() const { return emission.r > 0.0f || emission.g > 0.0f || emission.b > 0.0f; }
+  // Whether any texture of the material is read (then its triangles need texture coordinates).
+  bool readsTextures() const {
+    return baseColorTexture >= 0 || emissiveTexture >= 0 || metallicRoughnessTexture >= 0 || normalTexture >= 0;
+  }
 };
 
-// One world-space triangle. Winding counter-clockwise seen from the front (glTF convention);
-// the geometric normal is normalize(cross(p1 - p0, p2 - p0)).
+// One world-space triangle, 52 bytes: the scene model is the biggest thing the host holds for a big
+// mesh (docs/big-scenes.md). Winding counter-clockwise seen from the front (glTF convention); the
+// geometric normal is normalize(cross(p1 - p0, p2 - p0)). The shading normals are kept as the
+// octahedral words the GPU reads (shading/oct_normal.h: within 4.3e-5 rad of the unit normal given);
+// texture coordinates are not here but in Scene::texcoords, kept only where a texture reads them.
 struct Triangle {
   glm::vec3 p[3];
-  glm::vec3 n[3];   // unit shading normals (flat normals when the mesh has none)
-  glm::vec2 uv[3];  // the material's UV set (TEXCOORD_0 or TEXCOORD_1, Material::texCoord), (0,0) when absent
+  std::uint32_t normalWord[3] = {kOctNoNormal, kOctNoNormal, kOctNoNormal};  // octEncode'd unit shading normals
   std::uint32_t material = 0;
+
+  // Corner k's unit shading normal, (0, 0, 0) when it has none (flat normals are stored as normals).
+  glm::vec3 normal(int k) const { return octDecode(normalWord[k]); }
+  void setNormal(int k, const glm::vec3& n) { normalWord[k] = octEncode(n); }
+};
+static_assert(sizeof(Triangle) == 52, "Triangle: 3 positions, 3 normal words, material");
+
+// A triangle's texture coordinates: the material's UV set (TEXCOORD_0 or TEXCOORD_1, Material::texCoord).
+struct TriangleUv {
+  glm::vec2 uv[3]{glm::vec2(0.0f), glm::vec2(0.0f), glm::vec2(0.0f)};
 };
 
-// A triangle with positions only: normals and texture coordinates zero (OBJ meshes, tests, benchmarks).
+// A triangle with positions only: no normals, texture coordinates zero (OBJ meshes, tests, benchmarks).
 inline Triangle makeTriangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, std::uint32_t material = 0) {
   Triangle t{};
   t.p[0] = a;
@@ -115,6 +132,9 @@ struct Scene {
   std::string path;                  // file it was loaded from
   // World-space triangles, or (when `instances` is not empty) the meshes' object-space triangles.
   std::vector<Triangle> triangles;
+  // Texture coordinates of triangles[i] at texcoords[i]; empty when no material reads a texture (24 B per
+  // triangle saved), else exactly as long as `triangles`. Read them with triangleUv().
+  std::vector<TriangleUv> texcoords;
   // Empty unless loaded with LoadOptions::keepInstances: then every triangle belongs to exactly one
   // mesh and the scene is the union of its instances (flattenInstances makes it world space).
   std::vector<MeshRange> meshes;
@@ -135,6 +155,17 @@ struct Scene {
   Environment environment;
   Background background;
 };
+
+// Corner k's texture coordinates of triangle i; (0, 0) in a scene that keeps none.
+inline glm::vec2 triangleUv(const Scene& s, std::size_t i, int k) {
+  return s.texcoords.empty() ? glm::vec2(0.0f) : s.texcoords[i].uv[k];
+}
+// Whether a scene with these materials keeps texture coordinates (Scene::texcoords).
+inline bool keepsTexcoords(const std::vector<Material>& materials) {
+  for (const Material& m : materials)
+    if (m.readsTextures()) return true;
+  return false;
+}
 
 // Whether anything in the scene emits light: an emissive material on a triangle, a punctual light or
 // an environment that emits.

@@ -6,6 +6,7 @@
 #include "shared/gpu_layout.h"
 
 namespace caustica {
+static_assert(kOctNoNormal == gpu::kOctZeroNormal, "oct_normal.h's zero word is gpu_layout.h's");
 
 namespace {
 float unpackSnorm(std::uint32_t bits) {  // GLSL unpackSnorm2x16 of one component

@@ -7,6 +7,10 @@
 
 namespace caustica {
 
+// The word of a zero normal ("none": the geometric normal is used), gpu::kOctZeroNormal (checked in
+// oct_normal.cpp), here so that the scene model needs no GPU header.
+constexpr std::uint32_t kOctNoNormal = 0x80008000u;
+
 // A unit vector (any length > 0 works; it is normalised) to packSnorm2x16 of its octahedral point;
 // gpu::kOctZeroNormal for a zero or non-finite vector. Rounds to the nearest of the four neighbouring
 // grid points in angle: the decoded normal is within 4.3e-5 rad of n (mean 2.1e-5; oct_normal_test).

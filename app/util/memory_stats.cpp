@@ -2,8 +2,12 @@
 #include "util/memory_stats.h"
 
 #include <sys/resource.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 namespace caustica {
@@ -35,5 +39,18 @@ std::uint64_t hostPeakBytes() {
 }
 
 std::uint64_t hostCurrentBytes() { return statusKiB("VmRSS"); }
+
+void memTrace(const char* phase) {
+  static const bool on = std::getenv("CAUSTICA_MEM_TRACE") != nullptr;
+  if (!on) return;
+  std::fprintf(stderr, "mem %s: rss %.1f MiB, peak %.1f MiB\n", phase, double(hostCurrentBytes()) / 1048576.0,
+               double(hostPeakBytes()) / 1048576.0);
+}
+
+void releaseFreedMemory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
 
 }  // namespace caustica

@@ -1,5 +1,6 @@
 // gpu_scene_test.cpp — packing for the GPU: alias-table frequencies, emitter weights matching the
-// shader's lightPdfArea(), material conversion and feature detection.
+// shader's lightPdfArea(), material conversion and feature detection, the TriShade words from the
+// scene model's compact triangles.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -7,7 +8,9 @@
 #include <random>
 
 #include "accel/gpu_scene.h"
+#include "shading/oct_normal.h"
 #include "shading/sampling.h"
+#include "util/error.h"
 
 using namespace caustica;
 
@@ -20,7 +23,7 @@ Triangle quadTri(float size, float y, std::uint32_t material, bool second) {
   } else {
     t.p[0] = a; t.p[1] = d; t.p[2] = c;
   }
-  for (auto& n : t.n) n = glm::vec3(0, -1, 0);
+  for (int k = 0; k < 3; ++k) t.setNormal(k, glm::vec3(0, -1, 0));
   t.material = material;
   return t;
 }
@@ -172,4 +175,78 @@ TEST_CASE("GGX materials: rough lobes switch CAUSTICA_GGX on; specular layer, da
   CHECK(g.texInfo[1].offset == g.texInfo[0].offset);
   CHECK(g.texInfo[1].uvRow0 == glm::vec4(2.0f, 0.0f, 0.5f, 0.0f));
   CHECK(g.texInfo[0].uvRow1 == glm::vec4(0.0f, 1.0f, 0.0f, 0.0f));
+}
+
+TEST_CASE("the scene model's compact triangle: normal words round trip, no normal by default, 52 bytes") {
+  static_assert(sizeof(Triangle) == 52, "3 positions, 3 octahedral normal words, material");
+  Triangle t = makeTriangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  for (int k = 0; k < 3; ++k) {
+    CHECK(t.normalWord[k] == gpu::kOctZeroNormal);  // makeTriangle: no normal (the geometric one is used)
+    CHECK(t.normal(k) == glm::vec3(0.0f));
+  }
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  for (int i = 0; i < 1000; ++i) {
+    const glm::vec3 n = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+    t.setNormal(i % 3, n);
+    CHECK(t.normalWord[i % 3] == octEncode(n));  // the word the GPU read before the scene model kept words
+    const glm::vec3 d = t.normal(i % 3);
+    CHECK(glm::length(glm::cross(d, n)) < 5e-5f);  // oct_normal_test: within 4.3e-5 rad
+    CHECK(glm::dot(d, n) > 0.0f);
+  }
+  t.setNormal(1, glm::vec3(0.0f));
+  CHECK(t.normalWord[1] == gpu::kOctZeroNormal);
+}
+
+TEST_CASE("packing: TriShade words are the triangles' normal words, then their texcoords where textures read them") {
+  // The image depends on the scene model only through these words: the same words as octEncode of the
+  // float normals and the same float texcoords as before the 52-byte Triangle means the same image.
+  Scene s;
+  Material plain;
+  Material textured;
+  textured.baseColorTexture = 0;
+  Texture tex;
+  tex.width = tex.height = 1;
+  tex.rgba = {255, 255, 255, 255};
+  s.textures.push_back(tex);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
+  for (int i = 0; i < 50; ++i) {
+    const glm::vec3 c(u(rng) * 5.0f, u(rng) * 5.0f, u(rng) * 5.0f);
+    Triangle t = makeTriangle(c, c + glm::vec3(0.3f, 0.0f, 0.0f), c + glm::vec3(0.0f, 0.3f, u(rng) * 0.1f));
+    TriangleUv tuv;
+    for (int k = 0; k < 3; ++k) {
+      normals.push_back(glm::normalize(glm::vec3(u(rng), u(rng), 1.0f)));
+      t.setNormal(k, normals.back());
+      uvs.push_back(glm::vec2(u(rng), u(rng)));
+      tuv.uv[k] = uvs.back();
+    }
+    s.triangles.push_back(t);
+    s.texcoords.push_back(tuv);
+  }
+  for (const bool withTexture : {false, true}) {
+    CAPTURE(withTexture);
+    s.materials = {withTexture ? textured : plain};
+    const Bvh bvh = buildBvh(s.triangles);
+    const GpuScene p = packScene(s, bvh);
+    REQUIRE(p.triShadeStride == (withTexture ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords));
+    REQUIRE(p.triShade.size() == s.triangles.size() * p.triShadeStride);
+    for (std::size_t j = 0; j < s.triangles.size(); ++j) {
+      const std::size_t i = bvh.order[j];
+      const std::uint32_t* w = p.triShade.data() + j * p.triShadeStride;
+      for (int k = 0; k < 3; ++k) {
+        CHECK(w[k] == octEncode(normals[3 * i + std::size_t(k)]));
+        if (!withTexture) continue;
+        float x, y;
+        std::memcpy(&x, &w[3 + 2 * k], 4);
+        std::memcpy(&y, &w[4 + 2 * k], 4);
+        CHECK(x == uvs[3 * i + std::size_t(k)].x);
+        CHECK(y == uvs[3 * i + std::size_t(k)].y);
+      }
+    }
+  }
+  s.texcoords.pop_back();  // neither empty nor one per triangle: refused
+  CHECK_THROWS_AS(packScene(s, buildBvh(s.triangles)), Error);
 }

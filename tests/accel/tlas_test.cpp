@@ -35,7 +35,7 @@ Scene instancedScene(std::uint32_t seed, int instances) {
   s.meshes.push_back({300, 2, 1});
   for (Triangle& t : s.triangles) {
     const glm::vec3 n = glm::normalize(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]));
-    t.n[0] = t.n[1] = t.n[2] = n;
+    for (int k = 0; k < 3; ++k) t.setNormal(k, n);
   }
   for (int i = 0; i < instances; ++i) {
     glm::dmat4 m(1.0);

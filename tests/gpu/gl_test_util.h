@@ -43,7 +43,7 @@ inline void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d
     Triangle t{};
     for (int i = 0; i < 3; ++i) {
       t.p[i] = tri[i];
-      t.n[i] = n;
+      t.setNormal(i, n);
     }
     t.material = material;
     s.triangles.push_back(t);
@@ -62,7 +62,7 @@ inline void addSphere(Scene& s, glm::vec3 center, float radius, int segments, st
       for (auto idx : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
         Triangle t{};
         for (int k = 0; k < 3; ++k) {
-          t.n[k] = q[idx[k]];
+          t.setNormal(k, q[idx[k]]);
           t.p[k] = center + radius * q[idx[k]];
         }
         if (glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) == 0.0f) continue;  // pole slivers

@@ -682,15 +682,18 @@ TEST_CASE("normal maps and KHR_texture_transform change the shading normal as th
   const glm::vec2 uv[4] = {{0.0f, 0.45f}, {0.45f, 0.45f}, {0.45f, 0.0f}, {0.0f, 0.0f}};  // u along +x, v down
   for (auto idx : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
     Triangle t{};
+    TriangleUv tuv;
     for (int k = 0; k < 3; ++k) {
       t.p[k] = p[idx[k]];
-      t.n[k] = glm::vec3(0, 0, 1);
-      t.uv[k] = uv[idx[k]];
+      t.setNormal(k, glm::vec3(0, 0, 1));
+      tuv.uv[k] = uv[idx[k]];
     }
     s.triangles.push_back(t);
+    s.texcoords.push_back(tuv);
   }
   const float h = 0.3f;
   addQuad(s, {-h, h, 8}, {h, h, 8}, {h, -h, 8}, {-h, -h, 8}, 1);  // facing -z, down onto the square
+  s.texcoords.resize(s.triangles.size());  // one per triangle: the light's (0, 0)
   for (const auto& t : s.triangles)
     for (const auto& q : t.p) s.bounds.grow(q);
   Camera cam;

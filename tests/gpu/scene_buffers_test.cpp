@@ -43,8 +43,12 @@ Scene splitScene() {
   addQuad(s, {-2.0f, 0, 2.0f}, {2.0f, 0, 2.0f}, {2.0f, 0, -2.0f}, {-2.0f, 0, -2.0f}, 0);
   addQuad(s, {-0.4f, 2.5f, -0.4f}, {0.4f, 2.5f, -0.4f}, {0.4f, 2.5f, 0.4f}, {-0.4f, 2.5f, 0.4f}, 1);
   addSphere(s, {0.0f, 0.7f, 0.0f}, 0.6f, 12, 2);
-  for (Triangle& t : s.triangles)
-    for (int k = 0; k < 3; ++k) t.uv[k] = glm::vec2(t.p[k].x * 2.0f, t.p[k].z * 2.0f + t.p[k].y);  // texcoords everywhere
+  s.texcoords.resize(s.triangles.size());
+  for (std::size_t i = 0; i < s.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& p = s.triangles[i].p[k];
+      s.texcoords[i].uv[k] = glm::vec2(p.x * 2.0f, p.z * 2.0f + p.y);  // texcoords everywhere
+    }
   for (const auto& t : s.triangles)
     for (const auto& p : t.p) s.bounds.grow(p);
   Camera cam;

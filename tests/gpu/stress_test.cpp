@@ -292,7 +292,7 @@ TEST_CASE("stress: the camera inside geometry: a closed furnace sphere, and a cl
     addSphere(s, glm::vec3(0), 1.0f, 24, 0);
     for (Triangle& t : s.triangles) std::swap(t.p[1], t.p[2]);  // fronts face inwards
     for (Triangle& t : s.triangles)
-      for (glm::vec3& nn : t.n) nn = -nn;
+      for (int k = 0; k < 3; ++k) t.setNormal(k, -t.normal(k));
     finish(s);
     const Camera cam = lookAt(glm::vec3(0.2f, 0.1f, 0.3f), glm::vec3(1, 0, 0), 1.2f);
     for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
@@ -327,10 +327,10 @@ TEST_CASE("stress: slivers, degenerate triangles and grazing views give the imag
           const glm::vec3 a = glm::mix(corners[k], corners[(k + 1) % 4], float(i) / per);
           const glm::vec3 b = glm::mix(corners[k], corners[(k + 1) % 4], float(i + 1) / per);
           Triangle t = makeTriangle(c, a, b, 0);
-          for (glm::vec3& nn : t.n) nn = glm::vec3(0, 1, 0);
+          for (int j = 0; j < 3; ++j) t.setNormal(j, glm::vec3(0, 1, 0));
           s.triangles.push_back(t);
           Triangle d = makeTriangle(a, a, b, 0);  // zero area: must never be hit
-          for (glm::vec3& nn : d.n) nn = glm::vec3(0, 1, 0);
+          for (int j = 0; j < 3; ++j) d.setNormal(j, glm::vec3(0, 1, 0));
           s.triangles.push_back(d);
         }
     }

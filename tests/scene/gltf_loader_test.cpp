@@ -185,7 +185,8 @@ TEST_CASE("every shipped scene loads with triangles, lights, a camera and consis
     for (const auto& t : s.triangles) {
       REQUIRE(t.material < s.materials.size());
       const glm::vec3 g = geometricNormal(t);
-      for (const glm::vec3& n : t.n) {
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3 n = t.normal(k);
         CHECK(std::abs(glm::length(n) - 1.0f) < 1e-4f);
         if (glm::dot(n, g) <= 0.0f) ++disagree;
       }
@@ -296,8 +297,8 @@ TEST_CASE("cornell-textured: textures decode with row 0 at the top and repeat") 
   const std::size_t bottomLeft = std::size_t(127 * 128) * 4;
   CHECK(grid.rgba[bottomLeft] != 190);
   float maxU = 0.0f;
-  for (const auto& t : s.triangles)
-    for (const auto& uv : t.uv) maxU = std::max(maxU, uv.x);
+  for (std::size_t i = 0; i < s.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) maxU = std::max(maxU, caustica::triangleUv(s, i, k).x);
   CHECK(maxU > 1.5f);  // coordinates repeat the textures several times
 }
 
@@ -312,7 +313,7 @@ TEST_CASE("cornell-dispersion, bunny light and furnaces follow the material cont
     for (const auto& t : s.triangles)
       if (&s.materials[t.material] == prism && (t.p[0].x + t.p[1].x + t.p[2].x) / 3.0f > 0.35f) {
         ++prismTriangles;  // the prism stands right of the sphere; it has no NORMAL: flat normals
-        for (const auto& n : t.n) CHECK(near(n, geometricNormal(t), 1e-4f));
+        for (int k = 0; k < 3; ++k) CHECK(near(t.normal(k), geometricNormal(t), 1e-4f));
       }
     CHECK(prismTriangles == 8);
   }
@@ -365,7 +366,7 @@ TEST_CASE("node transforms: negative scale flips the winding, normals use the in
     const Scene s = g.load(dir);
     REQUIRE(s.triangles.size() == 1);
     const auto& t = s.triangles[0];
-    CHECK(near(t.n[0], glm::vec3(0, 0, 1)));
+    CHECK(near(t.normal(0), glm::vec3(0, 0, 1), 1e-4f));
     CHECK(near(geometricNormal(t), glm::vec3(0, 0, 1)));  // mirrored, and re-wound to face +z
     bool mirrored = false;
     for (const auto& p : t.p) mirrored = mirrored || near(p, glm::vec3(-1, 0, 0));
@@ -385,9 +386,10 @@ TEST_CASE("node transforms: negative scale flips the winding, normals use the in
     const auto& t = s.triangles[0];
     // (1,0,0) -> scale (2,0,0) -> rotate (0,2,0) -> translate; positions are relative to Scene::origin
     CHECK(near(t.p[0] + glm::vec3(s.origin), glm::vec3(0, 2, 5)));
-    for (const auto& n : t.n) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 n = t.normal(k);
       CHECK(std::abs(glm::length(n) - 1.0f) < 1e-5f);
-      CHECK(near(n, geometricNormal(t)));  // a plain M * n would tilt the normal off the surface
+      CHECK(near(n, geometricNormal(t), 1e-4f));  // within the octahedral words' 4.3e-5 rad  // a plain M * n would tilt the normal off the surface
     }
   }
   SUBCASE("a small object far from the origin keeps its precision (rebased in double)") {
@@ -460,8 +462,8 @@ TEST_CASE("primitives: index types, non-indexed, strips, fans, flat normals, deg
                                                                        0, 0, 1, 0, 1, 1, 0, 0, 2})}}}})}});
     const Scene s = g.load(dir);
     REQUIRE(s.triangles.size() == 2);
-    CHECK(near(s.triangles[0].n[1], glm::vec3(0, 0, 1)));
-    CHECK(near(s.triangles[1].n[2], glm::vec3(1, 0, 0)));
+    CHECK(near(s.triangles[0].normal(1), glm::vec3(0, 0, 1), 1e-4f));
+    CHECK(near(s.triangles[1].normal(2), glm::vec3(1, 0, 0), 1e-4f));
     REQUIRE(s.materials.size() == 1);
     CHECK(s.materials[0].metallic == 0.0f);
     CHECK(s.materials[0].baseColor.r == doctest::Approx(0.8));
@@ -502,13 +504,48 @@ TEST_CASE("accessors: normalized texcoords and sparse substitution") {
       const int uv = type == kByte ? g.accessor(std::vector<std::uint8_t>{0, 255, 51, 0, 255, 255}, type, "VEC2", true)
                                    : g.accessor(std::vector<std::uint16_t>{0, 65535, 13107, 0, 65535, 65535}, type,
                                                 "VEC2", true);
-      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}, {"TEXCOORD_0", uv}}}})}});
+      // A material that reads a texture: only then are texture coordinates kept (Scene::texcoords).
+      const unsigned char png[4] = {255, 0, 0, 255};
+      REQUIRE(stbi_write_png((dir.path / "one.png").string().c_str(), 1, 1, 4, png, 4));
+      g.doc["images"] = {{{"uri", "one.png"}}};
+      g.doc["textures"] = {{{"source", 0}}};
+      const int textured = g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}, {"TEXCOORD_0", uv}}},
+                               {"material", textured}})}});
       const Scene s = g.load(dir);
       REQUIRE(s.triangles.size() == 1);
-      CHECK(s.triangles[0].uv[0].x == doctest::Approx(0.0));
-      CHECK(s.triangles[0].uv[0].y == doctest::Approx(1.0));
-      CHECK(s.triangles[0].uv[1].x == doctest::Approx(0.2));
-      CHECK(s.triangles[0].uv[2].y == doctest::Approx(1.0));
+      REQUIRE(s.texcoords.size() == 1);
+      CHECK(s.texcoords[0].uv[0].x == doctest::Approx(0.0));
+      CHECK(s.texcoords[0].uv[0].y == doctest::Approx(1.0));
+      CHECK(s.texcoords[0].uv[1].x == doctest::Approx(0.2));
+      CHECK(s.texcoords[0].uv[2].y == doctest::Approx(1.0));
+    }
+  }
+  SUBCASE("texture coordinates are kept only when a material reads a texture") {
+    // The same TEXCOORD_0 without a textured material: nothing stored (24 B per triangle saved), and
+    // triangleUv reads (0, 0); with one, one TriangleUv per triangle, untextured triangles included.
+    const int kinds[2] = {0, 1};
+    for (int withTexture : kinds) {
+      CAPTURE(withTexture);
+      Gltf g;
+      const int uv = g.accessor(std::vector<float>{0.25f, 0.5f, 0.75f, 0.5f, 0.25f, 1.0f}, kFloat, "VEC2");
+      const int pos = g.positions(kTriangle);
+      g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}})}});  // default material
+      if (withTexture) {
+        const unsigned char png[4] = {0, 255, 0, 255};
+        REQUIRE(stbi_write_png((dir.path / "one.png").string().c_str(), 1, 1, 4, png, 4));
+        g.doc["images"] = {{{"uri", "one.png"}}};
+        g.doc["textures"] = {{{"source", 0}}};
+        const int m = g.add("materials", {{"emissiveTexture", {{"index", 0}}}});
+        g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", m}})}});
+      }
+      const Scene s = g.load(dir);
+      REQUIRE(s.triangles.size() == std::size_t(1 + withTexture));
+      CHECK(s.texcoords.size() == (withTexture ? s.triangles.size() : 0u));
+      for (std::size_t i = 0; i < s.triangles.size(); ++i) {
+        const glm::vec2 expect = withTexture ? glm::vec2(0.75f, 0.5f) : glm::vec2(0.0f);
+        CHECK(caustica::triangleUv(s, i, 1) == expect);
+      }
     }
   }
   SUBCASE("texcoords that are not normalized integers are rejected") {
@@ -784,12 +821,13 @@ TEST_CASE("textures: a material whose textures all name TEXCOORD_1 reads that se
   CHECK(hasWarning(s, "TEXCOORD_0, TEXCOORD_1"));
   CHECK(hasWarning(s, "which the primitive lacks"));
   for (const caustica::Triangle& t : s.triangles) {
-    const bool readsSet1 = s.materials[t.material].name == "set1" && t.uv[1].x > 0.5f;
+    const std::size_t i = std::size_t(&t - s.triangles.data());
+    const bool readsSet1 = s.materials[t.material].name == "set1" && caustica::triangleUv(s, i, 1).x > 0.5f;
     const glm::vec2 expect = readsSet1 ? glm::vec2(0.9f, 0.7f) : glm::vec2(0.2f, 0.1f);
-    CHECK(glm::length(t.uv[1] - expect) < 1e-6f);
+    CHECK(glm::length(caustica::triangleUv(s, i, 1) - expect) < 1e-6f);
   }
   int set1Triangles = 0;
-  for (const caustica::Triangle& t : s.triangles) set1Triangles += t.uv[0].x > 0.5f;
+  for (std::size_t i = 0; i < s.triangles.size(); ++i) set1Triangles += caustica::triangleUv(s, i, 0).x > 0.5f;
   CHECK(set1Triangles == 1);  // only the primitive that has TEXCOORD_1
 }
 
@@ -1120,8 +1158,9 @@ TEST_CASE("instancing: keepInstances stores each mesh once; flattenInstances giv
     CHECK(a.material == b.material);
     for (int k = 0; k < 3; ++k) {
       CHECK(a.p[k] == b.p[k]);  // the same double arithmetic: bit for bit
-      CHECK(near(a.n[k], b.n[k]));
-      CHECK(a.uv[k] == b.uv[k]);
+      // flattenInstances transforms the stored (octahedral) normal and encodes it again: within 2 x 4.3e-5 rad
+      CHECK(near(a.normal(k), b.normal(k), 1e-4f));
+      CHECK(caustica::triangleUv(flat, i, k) == caustica::triangleUv(inst, i, k));
     }
   }
   // EXT_mesh_gpu_instancing in the flattened scene: instance 1 is rotated 90 deg about y and moved by (5,0,0),
@@ -1184,6 +1223,6 @@ TEST_CASE("instancing: autoInstances keeps instances only where flattening multi
   for (std::size_t i = 0; i < flat.triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       CHECK(flat.triangles[i].p[k] == four.triangles[i].p[k]);
-      CHECK(flat.triangles[i].n[k] == four.triangles[i].n[k]);
+      CHECK(flat.triangles[i].normalWord[k] == four.triangles[i].normalWord[k]);
     }
 }
