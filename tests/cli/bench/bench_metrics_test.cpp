@@ -11,6 +11,7 @@
 
 #include "scene/assets.h"
 #include "cli/bench/bench_metrics.h"
+#include "image/error_estimate.h"
 #include "util/error.h"
 
 using namespace caustica;
@@ -283,4 +284,38 @@ TEST_CASE("CSV rows have one field per header column, quoted where needed") {
   CHECK(lines == 3);
   std::filesystem::remove(path);
   CHECK_THROWS_AS(writeBenchCsv("/nonexistent-dir/x.csv", {r}), Error);
+}
+
+TEST_CASE("tile variance: per-sample relative variance per tile from a render's halves, weighted by a reference") {
+  // 64x32 pixels of mean 1, the left half's samples with sd 0.1, the right half's 0.4; 64 samples a
+  // pixel, odd-numbered ones in the half image as the shader splits them. Per-sample relative variance
+  // sd^2 / (1 + 0.01) per tile; the bound over the tiles: mean(v) / mean(sqrt v)^2 = 0.085 / 0.0625.
+  const int w = 64, h = 32, spp = 64;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<float> accum(size_t(w) * h * 4, 0.0f), comp = accum, half = accum;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      const double sd = x < w / 2 ? 0.1 : 0.4;
+      for (int k = 0; k < spp; ++k) {
+        for (int c = 0; c < 3; ++c) {
+          const float s = static_cast<float>(1.0 + sd * unit(rng));
+          accum[i * 4 + c] += s;
+          if (k % 2 == 1) half[i * 4 + c] += s;
+        }
+        accum[i * 4 + 3] += 1.0f;
+        if (k % 2 == 1) half[i * 4 + 3] += 1.0f;
+      }
+    }
+  const Image reference = constantImage(w, h, 1.0f);
+  const std::vector<double> v = tileRelVariance(accum, comp, half, reference, 4);
+  REQUIRE(v.size() == size_t(16 * 8));
+  double left = 0.0, right = 0.0;
+  for (int ty = 0; ty < 8; ++ty)
+    for (int tx = 0; tx < 16; ++tx) (tx < 8 ? left : right) += v[size_t(ty) * 16 + tx] / 64.0;
+  CHECK(relDiff(left, 0.01 / 1.01) < 0.08);
+  CHECK(relDiff(right, 0.16 / 1.01) < 0.08);
+  CHECK(relDiff(adaptiveGainBound(v), 0.085 / 0.0625) < 0.08);
+  CHECK_THROWS_AS(tileRelVariance(accum, comp, half, constantImage(w, h + 1, 1.0f), 4), Error);
 }
