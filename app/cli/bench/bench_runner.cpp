@@ -216,6 +216,7 @@ class BenchRunner {
       renderer.renderPass(std::max(1, std::min(renderer.samplesPerDispatch(), nextCheck - renderer.samplesPerPixel())));
       if (renderer.samplesPerPixel() >= nextCheck) {
         sampler.check(renderer);
+        if (sampler.done()) break;  // no live tile left (an image without noise)
         nextCheck = sampler.checkAtOrAfter(renderer.samplesPerPixel() + 1);
       }
     }
