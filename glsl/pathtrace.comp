@@ -172,7 +172,7 @@ bool pathBounce(inout PathState s) {
     vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
     if (dot(ns, ngFront) < 0.0) ns = -ns;
     vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
-    Material m = materials[floatBitsToUint(g.v0.w)];
+    Material m = materialAt(floatBitsToUint(g.v0.w));
 #ifdef CAUSTICA_TEXTURES
     ns = applyNormalMap(m, ns, uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
 #endif
@@ -184,7 +184,7 @@ bool pathBounce(inout PathState s) {
 #ifdef CAUSTICA_SPOT_EMITTERS
       w *= spotEmitterFactor(m, -s.dir);  // a --light-radius sphere of a spot light emits into its cone
 #endif
-#ifdef CAUSTICA_MIS
+#if defined(CAUSTICA_MIS) && !defined(CAUSTICA_NO_EMITTERS)
       if (!s.prevDelta) {
 #ifdef CAUSTICA_INSTANCED
         float pdfLight = instanceLightPdfArea(g, xf, s.prevP, s.prevN) * hit.t * hit.t / max(abs(dot(ngFront, s.dir)), 1.0e-12);
@@ -211,37 +211,69 @@ bool pathBounce(inout PathState s) {
     vec3 newDir;
     vec2 metalRough = materialMetalRough(m, uv);
     uint lobe = chooseLobe(m, metalRough.x, metalRough.y, rand01(s.rng));
-    if (lobe == kLobeDiffuse) {
-#ifdef CAUSTICA_CASTERS
-      // Cosine sampling mixed with directions aimed at glass and mirror objects (casters.glsl): more
-      // paths reach the caustics they focus; the mixture pdf keeps the estimate unbiased and enters MIS.
-      // Only at the path's first diffuse vertex (the caustics the camera sees; deeper vertices gain
-      // less than they cost, docs/path-tracer.md), and not at the last vertex the depth limit allows.
-      float uChoose = rand01(s.rng);
-      if (s.firstDiffuse && depth + 1u < maxDepth) prepareCasters(p, ns, uChoose);
-      else gCasterUsable = 0u;
-      s.firstDiffuse = false;
-      float uPick = rand01(s.rng);
-      newDir = sampleDiffuseDirection(ns, uPick, rand2(s.rng));
+    // llvmpipe runs both sides of every branch (masked) for all 8 lanes of a SIMD group, and a loop's
+    // body at least once, so each call site of a light estimate or a traversal costs on every bounce
+    // whichever lobe the lanes took. The non-delta lobes (Lambertian and GGX) therefore share one
+    // vertex and one call of each next-event estimate; each lobe draws its random numbers in the same
+    // order as before (its own ones first, then the lights', then its direction), so images are
+    // unchanged (docs/benchmarks.md, "Session 5").
+    bool diffuse = lobe == kLobeDiffuse;
+#ifdef CAUSTICA_GGX
+    bool glossy = lobe >= kLobeConductor;  // GGX lobes: rough metal, plastic, rough glass (microfacet.glsl)
+#else
+    const bool glossy = false;
 #endif
-#if defined(CAUSTICA_MIS) || defined(CAUSTICA_PUNCTUAL)
-      // The Lambertian vertex as every light estimate below sees it (vertex.glsl), built once.
-      Vertex v = makeVertex(makeBsdf(m, kLobeDiffuse, base.rgb, 1.0, 1.0), p, pError, ng, ns, s.dir, s.sigma, s.sigma);
+#ifdef CAUSTICA_GLASS
+    // Both glass lobes take the wavelength's index of refraction first (one call for the two lobes).
+    float ior = 1.0;
+    if (lobe == kLobeGlass || lobe == kLobeRoughGlass) ior = glassIor(m, s.lambda, s.filt, s.rng);
+#endif
+    if (diffuse || glossy) {
+      float eta = 1.0;            // GGX: n beyond the surface / n on the ray's side (rough glass only)
+      vec3 sigmaBelow = s.sigma;  // the medium beyond the surface
+#ifdef CAUSTICA_CASTERS
+      if (diffuse) {
+        // Cosine sampling mixed with directions aimed at glass and mirror objects (casters.glsl): more
+        // paths reach the caustics they focus; the mixture pdf keeps the estimate unbiased and enters MIS.
+        // Only at the path's first diffuse vertex (the caustics the camera sees; deeper vertices gain
+        // less than they cost, docs/path-tracer.md), and not at the last vertex the depth limit allows.
+        float uChoose = rand01(s.rng);
+        if (s.firstDiffuse && depth + 1u < maxDepth) prepareCasters(p, ns, uChoose);
+        else gCasterUsable = 0u;
+        s.firstDiffuse = false;
+        float uPick = rand01(s.rng);
+        newDir = sampleDiffuseDirection(ns, uPick, rand2(s.rng));
+      }
+#endif
+#if defined(CAUSTICA_GGX) && defined(CAUSTICA_GLASS)
+      if (lobe == kLobeRoughGlass) {
+        eta = front ? ior : 1.0 / ior;
+#ifdef CAUSTICA_VOLUME
+        sigmaBelow = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
+#endif
+      }
+#endif
+#if defined(CAUSTICA_MIS) || defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_GGX)
+      // The vertex as every light estimate below sees it (vertex.glsl), built once: the Lambertian lobe
+      // (roughness and eta 1) or the GGX lobe.
+      Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, diffuse ? 1.0 : metalRough.y, eta), p, pError, ng, ns, s.dir,
+                            s.sigma, sigmaBelow);
 #endif
 #ifdef CAUSTICA_MIS
       // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
       // traced (not at the last vertex the depth limit allows), so both estimators end alike.
-      if (depth + 1u < maxDepth) {
-        s.radiance += s.beta * s.filt * sampleEmitterLight(v, s.rng, gShadowRays);
-      }
+      if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * sampleEmitterLight(v, s.rng, gShadowRays);
       // The environment's and the punctual lights' numbers are drawn in every shader variant, with the
       // feature or without: all variants then draw the same random numbers for the same path, so the
       // all-features shader renders the specialised shader's image to float rounding (a test compares).
       vec2 uEnv = rand2(s.rng);
 #ifdef CAUSTICA_ENV
-      // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl).
-      // Not inside an absorbing medium: the ray could only leave through its boundary.
-      if (depth + 1u < maxDepth && s.sigma == vec3(0.0)) s.radiance += s.beta * s.filt * addEnvironmentLight(v, uEnv);
+      // The environment's own next-event estimate (an independent shadow ray; environment_light.glsl),
+      // through this lobe (both sides for rough glass), matching the MIS weight escaped rays get after
+      // this vertex. Not from a Lambertian vertex inside an absorbing medium: the ray could only leave
+      // through its boundary.
+      if (depth + 1u < maxDepth && (!diffuse || s.sigma == vec3(0.0)))
+        s.radiance += s.beta * s.filt * addEnvironmentLight(v, uEnv);
 #endif
 #endif
       float uPunctual = rand01(s.rng);
@@ -250,23 +282,41 @@ bool pathBounce(inout PathState s) {
       // in both integrators, since a bounce never finds a delta light.
       if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * addPunctualLight(v, uPunctual);
 #endif
+      if (diffuse) {
 #ifdef CAUSTICA_CASTERS
-      float cosOut = dot(newDir, ns);
-      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) return false;  // below the true surface: absorbed
-      float pdfDir = diffuseDirectionPdf(ns, newDir);
-      s.beta *= base.rgb * (cosOut * INV_PI / pdfDir);
-      s.prevPdf = pdfDir;
+        float cosOut = dot(newDir, ns);
+        if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) return false;  // below the true surface: absorbed
+        float pdfDir = diffuseDirectionPdf(ns, newDir);
+        s.beta *= base.rgb * (cosOut * INV_PI / pdfDir);
+        s.prevPdf = pdfDir;
 #else
-      vec3 t, b;
-      orthonormalBasis(ns, t, b);
-      vec3 local = sampleCosineHemisphere(rand2(s.rng));
-      newDir = normalize(local.x * t + local.y * b + local.z * ns);
-      float cosOut = dot(newDir, ns);
-      if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) return false;  // below the true surface: absorbed
-      s.beta *= base.rgb;
-      s.prevPdf = cosOut * INV_PI;
+        vec3 t, b;
+        orthonormalBasis(ns, t, b);
+        vec3 local = sampleCosineHemisphere(rand2(s.rng));
+        newDir = normalize(local.x * t + local.y * b + local.z * ns);
+        float cosOut = dot(newDir, ns);
+        if (dot(newDir, ng) <= 0.0 || cosOut <= 0.0) return false;  // below the true surface: absorbed
+        s.beta *= base.rgb;
+        s.prevPdf = cosOut * INV_PI;
 #endif
-      s.prevDelta = false;
+        s.prevDelta = false;
+      }
+#ifdef CAUSTICA_GGX
+      else {
+        BsdfSample bs;
+        float uPart = rand01(s.rng);
+        if (!bsdfSample(v.bsdf, v.wo, vec3(uPart, rand2(s.rng)), bs)) return false;
+        newDir = vertexToWorld(v, bs.wi);
+        if (bs.transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0) return false;  // through the true surface: lost
+        s.beta *= bs.weight;
+        s.prevPdf = bs.pdf;
+        s.prevDelta = false;
+        if (bs.transmitted) {
+          s.etaScale *= eta * eta;
+          s.sigma = sigmaBelow;
+        }
+      }
+#endif
     }
 #ifdef CAUSTICA_MIRROR
     else if (lobe == kLobeMirror) {
@@ -276,53 +326,8 @@ bool pathBounce(inout PathState s) {
       s.prevDelta = true;
     }
 #endif
-#ifdef CAUSTICA_GGX
-    else if (lobe >= kLobeConductor) {  // GGX lobes: rough metal, plastic, rough glass (microfacet.glsl)
-      float eta = 1.0;
-      vec3 sigmaBelow = s.sigma;
-#ifdef CAUSTICA_GLASS
-      if (lobe == kLobeRoughGlass) {
-        float ior = glassIor(m, s.lambda, s.filt, s.rng);
-        eta = front ? ior : 1.0 / ior;  // n beyond the surface / n on the ray's side
-#ifdef CAUSTICA_VOLUME
-        sigmaBelow = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
-#endif
-      }
-#endif
-      Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, metalRough.y, eta), p, pError, ng, ns, s.dir, s.sigma, sigmaBelow);
-#ifdef CAUSTICA_MIS
-      if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * sampleEmitterLight(v, s.rng, gShadowRays);
-#endif
-#ifdef CAUSTICA_MIS
-      vec2 uEnv = rand2(s.rng);  // drawn with or without the feature, as at diffuse vertices
-#ifdef CAUSTICA_ENV
-      // The environment's next-event estimate through this lobe (both sides for rough glass), matching
-      // the MIS weight escaped rays get after this vertex (environment_light.glsl).
-      if (depth + 1u < maxDepth)
-        s.radiance += s.beta * s.filt * addEnvironmentLight(v, uEnv);
-#endif
-#endif
-      float uPunctual = rand01(s.rng);
-#ifdef CAUSTICA_PUNCTUAL
-      if (depth + 1u < maxDepth) s.radiance += s.beta * s.filt * addPunctualLight(v, uPunctual);
-#endif
-      BsdfSample bs;
-      float uPart = rand01(s.rng);
-      if (!bsdfSample(v.bsdf, v.wo, vec3(uPart, rand2(s.rng)), bs)) return false;
-      newDir = vertexToWorld(v, bs.wi);
-      if (bs.transmitted ? dot(newDir, ng) >= 0.0 : dot(newDir, ng) <= 0.0) return false;  // through the true surface: lost
-      s.beta *= bs.weight;
-      s.prevPdf = bs.pdf;
-      s.prevDelta = false;
-      if (bs.transmitted) {
-        s.etaScale *= eta * eta;
-        s.sigma = sigmaBelow;
-      }
-    }
-#endif
 #ifdef CAUSTICA_GLASS
     else {
-      float ior = glassIor(m, s.lambda, s.filt, s.rng);
       float eta = front ? ior : 1.0 / ior;  // n_transmitted / n_incident
       bool transmitted;
       float u = rand01(s.rng);

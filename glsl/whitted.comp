@@ -56,7 +56,7 @@ void pushRay(vec3 org, vec3 dir, vec3 weight, vec3 sigma, uint depth) {
 // Any hit with 0 < t < tmax that is not an emitter: the point lights stand in for the emissive
 // triangles, which therefore cast no shadows (a light's centre may lie inside its closed mesh).
 // traceOccluded with whittedOccluder as its filter (traverse.glsl, CAUSTICA_OCCLUDER_FILTER).
-bool whittedOccluder(uint tri) { return !isEmissive(materials[floatBitsToUint(triGeomAt(tri).v0.w)]); }
+bool whittedOccluder(uint tri) { return !isEmissive(materialAt(floatBitsToUint(triGeomAt(tri).v0.w))); }
 bool occludedByNonEmitter(vec3 org, vec3 dir, float tmax) { return traceOccluded(org, dir, tmax); }
 
 // Direct light from every point light at p, with a sharp shadow ray each (radiance towards wv).
@@ -137,7 +137,7 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
     if (dot(ns, ngFront) < 0.0) ns = -ns;
     if (!front) ns = -ns;
     vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
-    Material m = materials[floatBitsToUint(g.v0.w)];
+    Material m = materialAt(floatBitsToUint(g.v0.w));
 
     if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) radiance += w * materialEmission(m, uv);
 

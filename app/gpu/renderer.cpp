@@ -135,6 +135,10 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   bvhTextures_ = BvhTextures(buffers_[CAUSTICA_BINDING_NODES], bufferLayout_.nodes.count,
                              buffers_[CAUSTICA_BINDING_TRIGEOM], bufferLayout_.triGeom.count, scene.path,
                              std::move(wideBuffer), wideCount);
+  shadingTextures_ = ShadingTextures(buffers_[CAUSTICA_BINDING_MATERIALS], buffers_[CAUSTICA_BINDING_EMITTERS],
+                                     buffers_[CAUSTICA_BINDING_TEXELS],
+                                     bufferLayout_.triShade.parts == 1 ? &buffers_[CAUSTICA_BINDING_TRISHADE] : nullptr,
+                                     scene.path);
   memTrace("bvh textures");
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
@@ -200,6 +204,9 @@ std::vector<std::string> Renderer::shaderDefines() const {
   if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
+    // No emissive triangles (mis for the environment alone): the emitter estimate and the emitter-hit
+    // pdf are left out rather than run masked on every bounce (llvmpipe runs every branch; vertex.glsl).
+    if (gpuScene_.emitters.empty() && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
   }
   if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
@@ -389,6 +396,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
   environment_.bind();
   bvhTextures_.bind();
+  shadingTextures_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);

@@ -10,6 +10,7 @@
 
 #include "accel/bvh.h"
 #include "gpu/bvh_textures.h"
+#include "gpu/shading_textures.h"
 #include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
 #include "gpu/gl_objects.h"
@@ -141,6 +142,7 @@ class Renderer {
   GlLimits limits_;
   std::vector<GlBuffer> buffers_;  // indexed by CAUSTICA_BINDING_*
   BvhTextures bvhTextures_;  // the traversal's views of the nodes and TriGeom buffers
+  ShadingTextures shadingTextures_;  // the shading's views of the materials, light-tree and texture buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
   std::vector<LightGroup> lightGroups_;

@@ -1,7 +1,21 @@
 // light_tree.glsl — chooses an emissive triangle by its importance to a shading point, descending the
 // light tree (LightNode[] in gpu_layout.h, built by app/accel/light_tree.cpp), and gives the
 // probability of any triangle's choice for MIS. C++ twins of the same names in app/accel/light_tree.h.
-// Needs `lightNodes[]` (bindings.glsl, or a test shader's own buffer).
+// Reads the nodes through their buffer texture (CAUSTICA_TEXUNIT_LIGHT_NODES; a vector gather on llvmpipe,
+// where an SSBO load is a loop over the SIMD lanes). Needs gpu_layout.h.
+
+layout(binding = CAUSTICA_TEXUNIT_LIGHT_NODES) uniform usamplerBuffer lightNodeTexels;  // 4 texels per LightNode
+
+uvec4 lightNodeLink(uint i) { return texelFetch(lightNodeTexels, int(4u * i + 3u)); }
+LightNode lightNodeAt(uint i) {
+  int b = int(4u * i);
+  LightNode node;
+  node.boundsMin = uintBitsToFloat(texelFetch(lightNodeTexels, b));
+  node.boundsMax = uintBitsToFloat(texelFetch(lightNodeTexels, b + 1));
+  node.axis = uintBitsToFloat(texelFetch(lightNodeTexels, b + 2));
+  node.link = texelFetch(lightNodeTexels, b + 3);
+  return node;
+}
 
 float ltCosSubClamped(float sinA, float cosA, float sinB, float cosB) {  // cos(max(0, a - b))
   if (cosA > cosB) return 1.0;
@@ -57,9 +71,9 @@ bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
   tri = 0u;
   uint i = 0u;
   float prob = 1.0;
-  if ((lightNodes[0].link.y & kLightNodeLeaf) != 0u && !(lightImportance(lightNodes[0], p, n) > 0.0)) return false;
+  if ((lightNodeLink(0).y & kLightNodeLeaf) != 0u && !(lightImportance(lightNodeAt(0), p, n) > 0.0)) return false;
   for (int depth = 0; depth <= CAUSTICA_LIGHT_TREE_DEPTH; ++depth) {
-    uvec4 link = lightNodes[i].link;
+    uvec4 link = lightNodeLink(i);
     if ((link.y & kLightNodeLeaf) != 0u) {
       tri = link.x;
 #ifdef CAUSTICA_INSTANCED
@@ -68,8 +82,8 @@ bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
       pmf = prob;
       return true;
     }
-    float il = lightImportance(lightNodes[link.x], p, n);
-    float ir = lightImportance(lightNodes[link.x + 1u], p, n);
+    float il = lightImportance(lightNodeAt(link.x), p, n);
+    float ir = lightImportance(lightNodeAt(link.x + 1u), p, n);
     if (!(il + ir > 0.0)) return false;
     float pl = il / (il + ir);
     if (u < pl) {
@@ -88,14 +102,15 @@ bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
 // The probability that sampleLightTree(p, n) chooses the triangle of leaf node `leaf`: the same choices
 // repeated along the leaf's bit trail.
 float lightTreePdf(vec3 p, vec3 n, uint leaf) {
-  uint trail = lightNodes[leaf].link.z, depth = lightNodes[leaf].link.w;
-  if (depth == 0u) return lightImportance(lightNodes[0], p, n) > 0.0 ? 1.0 : 0.0;
+  uvec4 leafLink = lightNodeLink(leaf);
+  uint trail = leafLink.z, depth = leafLink.w;
+  if (depth == 0u) return lightImportance(lightNodeAt(0), p, n) > 0.0 ? 1.0 : 0.0;
   uint i = 0u;
   float prob = 1.0;
   for (uint k = 0u; k < depth; ++k) {
-    uint left = lightNodes[i].link.x;
-    float il = lightImportance(lightNodes[left], p, n);
-    float ir = lightImportance(lightNodes[left + 1u], p, n);
+    uint left = lightNodeLink(i).x;
+    float il = lightImportance(lightNodeAt(left), p, n);
+    float ir = lightImportance(lightNodeAt(left + 1u), p, n);
     if (!(il + ir > 0.0)) return 0.0;
     float pl = il / (il + ir);
     if (((trail >> k) & 1u) != 0u) {

@@ -60,7 +60,7 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   if (!(len > 0.0)) return false;
   ls.n = c / len;
   ls.material = floatBitsToUint(g.v0.w);
-  Material m = materials[ls.material];
+  Material m = materialAt(ls.material);
   vec2 uv = vec2(0.0);
 #ifdef CAUSTICA_TEXTURES
   vec2 t0, t1, t2;

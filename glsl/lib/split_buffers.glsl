@@ -2,8 +2,8 @@
 // hold them (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): TriGeom comes through its buffer texture (no block
 // limit); the TriShade words, when the host (app/gpu/scene_buffers.*) splits them, come from
 // CAUSTICA_TRISHADE_PARTS blocks of CAUSTICA_TRISHADE_PART words, part k > 0 bound at
-// CAUSTICA_TRISHADE_BINDING<k>. Without those defines (the usual case) triShadeWord reads its one
-// block. The BVH nodes are read through their own buffer texture (traverse.glsl). Included by bindings.glsl.
+// CAUSTICA_TRISHADE_BINDING<k>. Without those defines (the usual case) the words are read through
+// their buffer texture instead (triShadeTriple, tri_shade.glsl). The BVH nodes are read through their own buffer texture (traverse.glsl). Included by bindings.glsl.
 
 // TriGeom record i, read through the buffer texture the traversal uses (3 RGBA32UI texels; no SSBO, so
 // no storage-block limit: GL_MAX_TEXTURE_BUFFER_SIZE texels, checked by app/gpu/bvh_textures.cpp).
@@ -35,19 +35,18 @@ uint triShadeWord(uint i) {  // parts hold whole triangles (CAUSTICA_TRISHADE_PA
 #endif
   return triShadeWords1[j];
 }
-#else
-uint triShadeWord(uint i) { return triShadeWords[i]; }
-#endif
+#endif  // (unsplit, the words are read through a buffer texture: triShadeTriple in tri_shade.glsl)
 
-// The TexInfo record of texture `index`, from the head of the texel block.
+// The TexInfo record of texture `index`, from the head of the texel block (3 RGBA32UI texels).
 TexInfo texInfoAt(uint index) {
-  uint b = index * kTexInfoWords;
+  int b = int(3u * index);
+  uvec4 w = texelFetch(texInfoTexels, b);
   TexInfo t;
-  t.offset = texels[b];
-  t.width = texels[b + 1u];
-  t.height = texels[b + 2u];
-  t.flags = texels[b + 3u];
-  t.uvRow0 = uintBitsToFloat(uvec4(texels[b + 4u], texels[b + 5u], texels[b + 6u], texels[b + 7u]));
-  t.uvRow1 = uintBitsToFloat(uvec4(texels[b + 8u], texels[b + 9u], texels[b + 10u], texels[b + 11u]));
+  t.offset = w.x;
+  t.width = w.y;
+  t.height = w.z;
+  t.flags = w.w;
+  t.uvRow0 = uintBitsToFloat(texelFetch(texInfoTexels, b + 1));
+  t.uvRow1 = uintBitsToFloat(texelFetch(texInfoTexels, b + 2));
   return t;
 }

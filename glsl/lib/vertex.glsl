@@ -55,6 +55,14 @@ float vertexPdf(Vertex v, vec3 w) {
 // vertex's BSDF sampling by the power heuristic. Returns radiance (to be multiplied by the path
 // throughput); adds 1 to shadowRays for each visibility ray traced.
 vec3 sampleEmitterLight(Vertex v, inout uvec4 rng, inout uint shadowRays) {
+#ifdef CAUSTICA_NO_EMITTERS
+  // The scene has no emissive triangles (Renderer::shaderDefines): the estimate is 0, its numbers are
+  // drawn all the same (the random stream stays that of the other variants). Left out rather than run
+  // masked, since llvmpipe runs every branch and every loop at least once.
+  float uSelect = rand01(rng);
+  vec2 uTri = rand2(rng);
+  return vec3(0.0 * uSelect * uTri.x);
+#else
   LightSample ls;
   if (!sampleLight(v.p, v.ns, rand01(rng), rand2(rng), ls)) return vec3(0.0);
   vec3 toLight = ls.p - v.p;
@@ -87,7 +95,8 @@ vec3 sampleEmitterLight(Vertex v, inout uvec4 rng, inout uint shadowRays) {
   transmittance = exp(-(above ? v.sigmaAbove : v.sigmaBelow) * dist);  // the medium the shadow ray runs in
 #endif
 #ifdef CAUSTICA_SPOT_EMITTERS
-  ls.le *= spotEmitterFactor(materials[ls.material], -wl);  // a --light-radius spot sphere emits into its cone
+  ls.le *= spotEmitterFactor(materialAt(ls.material), -wl);  // a --light-radius spot sphere emits into its cone
 #endif
   return f * (w / pdfLight) * ls.le * transmittance;
+#endif
 }

@@ -20,10 +20,12 @@ using uint = std::uint32_t;
 // ---- binding indices (macros: GLSL 4.30 layout qualifiers take only literals) -------------------
 #define CAUSTICA_BINDING_NODES 0      // buffer of BvhNode[]; the shaders read it through CAUSTICA_TEXUNIT_BVH_NODES, not as an SSBO
 #define CAUSTICA_BINDING_TRIGEOM 1    // buffer of TriGeom[] (BVH leaf order); read through CAUSTICA_TEXUNIT_TRI_GEOM, not as an SSBO
-#define CAUSTICA_BINDING_TRISHADE 2   // SSBO: uint[] shading words per triangle (same order as TriGeom; kTriShadeWords)
-#define CAUSTICA_BINDING_MATERIALS 3  // SSBO: Material[]
-#define CAUSTICA_BINDING_EMITTERS 4   // SSBO: LightNode[] (light tree over emissive triangles)
-#define CAUSTICA_BINDING_TEXELS 5     // SSBO: uint[]: TexInfo records (kTexInfoWords each), then RGBA8 texels, sRGB-encoded
+#define CAUSTICA_BINDING_TRISHADE 2   // uint[] shading words per triangle (same order as TriGeom; kTriShadeWords): read through
+                                      // CAUSTICA_TEXUNIT_TRI_SHADE, or as SSBOs when split over several blocks
+#define CAUSTICA_BINDING_MATERIALS 3  // buffer of Material[]; read through CAUSTICA_TEXUNIT_MATERIALS, not as an SSBO
+#define CAUSTICA_BINDING_EMITTERS 4   // buffer of LightNode[] (light tree over emissive triangles); read through CAUSTICA_TEXUNIT_LIGHT_NODES
+#define CAUSTICA_BINDING_TEXELS 5     // buffer of uint[]: TexInfo records (kTexInfoWords each), then RGBA8 texels, sRGB-encoded;
+                                      // read through CAUSTICA_TEXUNIT_TEXELS and CAUSTICA_TEXUNIT_TEX_INFO
 #define CAUSTICA_BINDING_COUNTERS 6   // SSBO: Counters (atomic statistics)
 #define CAUSTICA_SSBO_COUNT 7         // buffers the path tracer binds (bindings 0-6; 0 and 1 are read as textures)
 #define CAUSTICA_BINDING_SPLIT_FIRST 7  // first binding of the extra parts of split arrays (split_buffers.glsl)
@@ -36,6 +38,13 @@ using uint = std::uint32_t;
 #define CAUSTICA_TEXUNIT_BVH_NODES 2   // texture unit: buffer texture (rgba32ui) over the nodes SSBO's buffer, 4 texels per BvhNode
 #define CAUSTICA_TEXUNIT_TRI_GEOM 3    // texture unit: buffer texture (rgba32ui) over the TriGeom buffer, 3 texels per triangle
 #define CAUSTICA_TEXUNIT_BVH_WIDE 6    // texture unit: buffer texture (rgba32ui) over the BvhWideNode buffer, 7 texels per node
+// The shading reads go through buffer textures too (app/gpu/shading_textures.*): on llvmpipe a texelFetch
+// is a vector gather, an SSBO load a loop over the SIMD lanes (docs/benchmarks.md, "Session 5").
+#define CAUSTICA_TEXUNIT_MATERIALS 4   // texture unit: buffer texture (rgba32ui) over the materials buffer, 7 texels per Material
+#define CAUSTICA_TEXUNIT_LIGHT_NODES 5 // texture unit: buffer texture (rgba32ui) over the light-tree buffer, 4 texels per LightNode
+#define CAUSTICA_TEXUNIT_TEXELS 7      // texture unit: buffer texture (r32ui) over the texel buffer, one word per texel
+#define CAUSTICA_TEXUNIT_TEX_INFO 8    // texture unit: buffer texture (rgba32ui) over the same buffer, 3 texels per TexInfo
+#define CAUSTICA_TEXUNIT_TRI_SHADE 9   // texture unit: buffer texture (rgb32ui) over the TriShade buffer (unless split), 3 words per texel
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with

@@ -5,8 +5,8 @@
 
 layout(local_size_x = 64) in;
 
-// bindings.glsl is not included: the tree sits at its usual binding, queries and results beside it.
-layout(std430, binding = CAUSTICA_BINDING_EMITTERS) readonly buffer EmitterBuffer { LightNode lightNodes[]; };
+// bindings.glsl is not included: the tree is read through its usual buffer texture (light_tree.glsl),
+// queries and results are SSBOs 0 and 1.
 #include "../lib/light_tree.glsl"
 
 // Per record: [0] xyz p, w u (float bits); [1] xyz n, w: leaf to query (uint); [2] x: node for lightImportance.
@@ -28,5 +28,5 @@ void main() {
   bool ok = sampleLightTree(a.xyz, n, a.w, tri, pmf);
   float pdf = lightTreePdf(a.xyz, n, b.w);
   outRec[2u * i] = uvec4(ok ? 1u : 0u, tri, floatBitsToUint(pmf), floatBitsToUint(pdf));
-  outRec[2u * i + 1u] = uvec4(floatBitsToUint(lightImportance(lightNodes[c.x], a.xyz, n)), 0u, 0u, 0u);
+  outRec[2u * i + 1u] = uvec4(floatBitsToUint(lightImportance(lightNodeAt(c.x), a.xyz, n)), 0u, 0u, 0u);
 }

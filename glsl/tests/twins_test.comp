@@ -11,6 +11,7 @@
 #include "../lib/casters.glsl"
 #include "../lib/punctual.glsl"  // without CAUSTICA_PUNCTUAL: spotFalloff only (no UBO)
 #include "../lib/oct_normal.glsl"
+#include "../lib/texture_wrap.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -54,6 +55,7 @@ const uint kBsdfEvalPdf = 24u;
 const uint kBsdfSample = 25u;
 const uint kSpotFalloff = 26u;
 const uint kOctDecode = 27u;
+const uint kWrapCoord = 28u;
 
 // The Bsdf of records for kBsdfEvalPdf and kBsdfSample: a[0].w = alpha, a[1].w = eta,
 // a[2] = (color, lobe), a[3].xy = (f0 grey, f90).
@@ -118,6 +120,10 @@ void main() {
     o[0] = bits(offsetRayOrigin(a[0].xyz, a[2].xyz, a[1].xyz), 0.0);
   } else if (function == kHitPointError) {  // a[0].xyz = (b0, b1, b2), a[1..3].xyz = p0, p1, p2
     o[0] = bits(hitPointError(a[0].x, a[0].y, a[0].z, a[1].xyz, a[2].xyz, a[3].xyz), 0.0);
+  } else if (function == kWrapCoord) {  // a[0].xy: (i, n) as int bits; floorMod, then clamp, repeat, mirror
+    int i = int(floatBitsToUint(a[0].x)), n = int(floatBitsToUint(a[0].y));
+    o[0] = uvec4(uint(floorMod(i, n)), uint(wrapCoord(i, n, false, false)), uint(wrapCoord(i, n, true, false)),
+                 uint(wrapCoord(i, n, false, true)));
   } else if (function == kOctDecode) {  // a[0].x: the word (uint)
     o[0] = bits(octDecode(floatBitsToUint(a[0].x)), 0.0);
   } else if (function == kSpotFalloff) {  // a[0].xyz = (cos theta, cos outer, cos inner)

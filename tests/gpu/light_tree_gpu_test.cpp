@@ -69,7 +69,8 @@ void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& node
   GlBuffer inBuf = GlBuffer::fromVector(in);
   GlBuffer outBuf = GlBuffer::create(sizeof(glm::uvec4) * 2 * n, nullptr, GL_DYNAMIC_READ);
   prog.use();
-  nodeBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_EMITTERS);
+  GlBufferTexture nodeTex = GlBufferTexture::create(nodeBuf, GL_RGBA32UI);  // as the renderer reads it
+  nodeTex.bind(CAUSTICA_TEXUNIT_LIGHT_NODES);
   inBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
   outBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
   glUniform1ui(0, static_cast<GLuint>(n));

@@ -146,6 +146,21 @@ TEST_CASE("the transparent-background variant (coverage image) compiles in both 
     }
 }
 
+TEST_CASE("the no-emitter variant (mis for the environment alone) compiles on top of every feature") {
+  ShaderLibrary lib;
+  const auto& names = shaderFeatureNames();
+  std::vector<std::vector<std::string>> bases = {{"CAUSTICA_MIS", "CAUSTICA_ENV"}, names};
+  for (const auto& n : names) bases.push_back({"CAUSTICA_MIS", "CAUSTICA_ENV", n});
+  for (auto defines : bases) {
+    defines.push_back("CAUSTICA_NO_EMITTERS");
+    std::string label;
+    for (const auto& d : defines) label += d + " ";
+    INFO("defines: ", label);
+    const std::string log = validate(lib.expand("pathtrace.comp", defines));
+    REQUIRE_MESSAGE(log.empty(), log);
+  }
+}
+
 TEST_CASE("the other entry shaders compile") {
   ShaderLibrary lib;
   for (const char* entry : {"tonemap.comp", "tests/trace_test.comp", "tests/trace_instanced_test.comp", "tests/twins_test.comp",

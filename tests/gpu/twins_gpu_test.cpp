@@ -20,6 +20,7 @@
 #include "accel/spawn.h"
 #include "shading/microfacet.h"
 #include "shading/oct_normal.h"
+#include "shading/texture_wrap.h"
 #include "shading/sampling.h"
 #include "scene/punctual_lights.h"
 
@@ -32,7 +33,8 @@ enum class Fn : GLuint {
   Pcg4d, RngSeed, Rand01, Luminance, OrthonormalBasis, SampleCosineHemisphere, SampleTriangleUniform,
   PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
   ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
-  DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError, Ggx, GgxSampleVisibleNormal, BsdfEvalPdf, BsdfSample, SpotFalloff, OctDecode
+  DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError, Ggx, GgxSampleVisibleNormal, BsdfEvalPdf, BsdfSample, SpotFalloff, OctDecode,
+  WrapCoord
 };
 
 constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
@@ -563,6 +565,29 @@ TEST_CASE("GLSL octDecode equals its C++ twin (octahedral normals of the TriShad
   // unpackSnorm2x16, adds and a normalize: measured 0 difference on llvmpipe; a few ULP allowed.
   compareOutput(gpu, Fn::OctDecode, in, MaxDiff("octDecode", 4 * kEps), Measure::Absolute,
                 [](const In& x) { return octDecode(x.w[0].x); });
+}
+
+TEST_CASE("GLSL floorMod and wrapCoord equal their C++ twins bit for bit (texture wrap without integer division)") {
+  GlslTwins gpu;
+  Random r(13);
+  std::vector<In> in;
+  auto add = [&](int i, int n) { in.push_back(uints({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(n), 0, 0})); };
+  for (int n : {1, 2, 3, 7, 255, 256, 1023, 4096, 16384})
+    for (int i : {0, -1, 1, 10000001, -10000001, 9999999, -9999999, n - 1, n, n + 1, -n - 1, -n, -n + 1, 2 * n - 1, 2 * n,
+                  -2 * n, 10000000 / n * n, -(10000000 / n * n) - 1})
+      add(i, n);
+  while (in.size() < 8192) add(static_cast<int>(r.g() % 20000003u) - 10000001, 1 + static_cast<int>(r.g() % 16384u));
+  // Integer results of exact float steps (texture_wrap.glsl): every value must agree, and the C++ twin
+  // equals the integer-division forms (tests/shading/texture_wrap_test.cpp).
+  std::vector<Out> out = gpu.run(Fn::WrapCoord, in);
+  Mismatches m("floorMod / wrapCoord (clamp, repeat, mirror)");
+  for (size_t k = 0; k < in.size(); ++k) {
+    const int i = static_cast<int>(in[k].w[0].x), n = static_cast<int>(in[k].w[0].y);
+    const glm::uvec4 want(static_cast<std::uint32_t>(floorMod(i, n)), static_cast<std::uint32_t>(wrapCoord(i, n, false, false)),
+                          static_cast<std::uint32_t>(wrapCoord(i, n, true, false)), static_cast<std::uint32_t>(wrapCoord(i, n, false, true)));
+    m.add(out[k].w[0] == want, [&] { return "i " + std::to_string(i) + ", n " + std::to_string(n); });
+  }
+  m.check();
 }
 
 TEST_CASE("GLSL caster functions equal their C++ twins: inCone, casterCone, sampleUniformCone, casterFacesLights") {
