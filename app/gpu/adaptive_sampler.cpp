@@ -17,6 +17,25 @@ int defaultAdaptiveTile() {
   throw Error("CAUSTICA_ADAPTIVE_TILE must be 1, 2, 4 or 8, not '" + s + "'");
 }
 
+int defaultMaxSppRatio() {
+  const char* v = std::getenv("CAUSTICA_ADAPTIVE_RATIO");
+  if (v == nullptr || *v == '\0') return kMaxSppRatio;
+  const std::string s(v);
+  if (s.find_first_not_of("0123456789") != std::string::npos || s.size() > 6 || std::stoi(s) < 1)
+    throw Error("CAUSTICA_ADAPTIVE_RATIO must be an integer from 1 to 999999, not '" + s + "'");
+  return std::stoi(s);
+}
+
+double defaultVarianceSmoothing() {
+  const char* v = std::getenv("CAUSTICA_ADAPTIVE_SMOOTHING");
+  if (v == nullptr || *v == '\0') return kVarianceSmoothing;
+  char* end = nullptr;
+  const double w = std::strtod(v, &end);
+  if (end == v || *end != '\0' || !(w >= 0.0 && w <= 1.0))
+    throw Error("CAUSTICA_ADAPTIVE_SMOOTHING must be a number from 0 to 1, not '" + std::string(v) + "'");
+  return w;
+}
+
 AdaptiveSampler::AdaptiveSampler(double targetError, bool adaptive, int minSpp, int tileSize)
     : target_(targetError), adaptive_(adaptive), minSpp_(std::max(2, minSpp)), tileSize_(tileSize) {
   if (tileSize != 1 && tileSize != 2 && tileSize != 4 && tileSize != 8) throw Error("adaptive tile size must be 1, 2, 4 or 8");
@@ -32,7 +51,7 @@ const ErrorEstimate& AdaptiveSampler::check(Renderer& renderer) {
   estimate_ = renderer.errorEstimate(tileSize_);
   liveTiles_ = renderer.liveTileCount();
   if (adaptive_) {
-    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, kMaxSppRatio, kTileDilation);
+    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, maxSppRatio_, kTileDilation, smoothing_);
     renderer.setLiveTiles(live, tileSize_);
     liveTiles_ = live.size();
   }

@@ -12,11 +12,18 @@ namespace caustica {
 constexpr int kMinAdaptiveSpp = 16;  // no tile stops before every pixel has this many samples
 constexpr int kTileDilation = 1;     // a tile with over 4x the mean gain keeps its 8 neighbours live
 constexpr int kMaxSppRatio = 8;      // no tile falls behind the most sampled one by more than this factor
+constexpr double kVarianceSmoothing = 0.5;  // weight of the 3x3 tile neighbourhood in a tile's variance (liveTiles)
 constexpr int kAdaptiveTile = 4;     // side of the tiles in pixels (1, 2, 4 or 8): 4 pays best (docs/benchmarks.md)
 
 // kAdaptiveTile, or the environment variable CAUSTICA_ADAPTIVE_TILE (1, 2, 4 or 8) where set: a knob
 // to measure other tile sizes with (docs/benchmarks.md, "Adaptive sampling"). Throws Error otherwise.
 int defaultAdaptiveTile();
+// kMaxSppRatio, or the environment variable CAUSTICA_ADAPTIVE_RATIO (an integer >= 1) where set: a knob
+// to measure the ratio guard with (docs/benchmarks.md, "Adaptive sampling"). Throws Error otherwise.
+int defaultMaxSppRatio();
+// kVarianceSmoothing, or the environment variable CAUSTICA_ADAPTIVE_SMOOTHING (a number in [0, 1]) where
+// set: a knob to measure the smoothing with (0 = each tile's own estimate). Throws Error otherwise.
+double defaultVarianceSmoothing();
 
 class AdaptiveSampler {
  public:
@@ -42,6 +49,8 @@ class AdaptiveSampler {
   bool adaptive_;
   int minSpp_;
   int tileSize_;
+  int maxSppRatio_ = defaultMaxSppRatio();
+  double smoothing_ = defaultVarianceSmoothing();
   ErrorEstimate estimate_;
   std::size_t liveTiles_ = 0;
   bool done_ = false;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace caustica {
 
@@ -95,13 +96,33 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   return e;
 }
 
-std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int maxSppRatio, int dilation) {
+std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int maxSppRatio, int dilation,
+                                     double smoothing) {
   const size_t tiles = e.tile.size();
-  std::vector<double> gain(tiles);
+  // Each tile's per-sample variance v = e n, blended with the mean over its 3x3 neighbourhood (finite
+  // values only; non-finite ones stay as they are and keep the tile live).
+  std::vector<double> perSample(tiles), gain(tiles);
+  for (size_t t = 0; t < tiles; ++t) perSample[t] = e.tile[t] * std::max(e.tileSppMin[t], 1);
   double meanGain = 0.0;
   int mostSpp = 0, finite = 0;
   for (size_t t = 0; t < tiles; ++t) {
-    gain[t] = e.tile[t] / std::max(e.tileSppMin[t], 1);
+    double v = perSample[t];
+    if (smoothing > 0.0 && std::isfinite(v)) {
+      const int tx = static_cast<int>(t % e.tilesX), ty = static_cast<int>(t / e.tilesX);
+      double sum = 0.0;
+      int k = 0;
+      for (int y = std::max(0, ty - 1); y <= std::min(e.tilesY - 1, ty + 1); ++y)
+        for (int x = std::max(0, tx - 1); x <= std::min(e.tilesX - 1, tx + 1); ++x) {
+          const double u = perSample[static_cast<size_t>(y) * e.tilesX + x];
+          if (std::isfinite(u)) {
+            sum += u;
+            ++k;
+          }
+        }
+      v = (1.0 - smoothing) * v + smoothing * sum / k;  // k >= 1: the tile itself is finite
+    }
+    const double n = std::max(e.tileSppMin[t], 1);
+    gain[t] = v / (n * n);  // = e / n without smoothing
     if (std::isfinite(gain[t])) {
       meanGain += gain[t];
       ++finite;
@@ -127,6 +148,58 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
       if (live[static_cast<size_t>(ty) * e.tilesX + tx])
         out.push_back(static_cast<std::uint32_t>(tx) | (static_cast<std::uint32_t>(ty) << 16));
   return out;
+}
+
+double adaptiveGainBound(const std::vector<double>& v) {
+  double sumV = 0.0, sumSigma = 0.0;
+  for (double x : v) {
+    if (!std::isfinite(x) || x < 0.0) return std::nan("");
+    sumV += x;
+    sumSigma += std::sqrt(x);
+  }
+  if (v.empty() || !(sumSigma > 0.0)) return std::nan("");
+  const double n = static_cast<double>(v.size());
+  return (sumV / n) / ((sumSigma / n) * (sumSigma / n));
+}
+
+double guardedAdaptiveGainBound(const std::vector<double>& v, double meanSpp, int minSpp, int maxSppRatio) {
+  const double bound = adaptiveGainBound(v);
+  if (!std::isfinite(bound)) return bound;
+  if (meanSpp <= minSpp) return 1.0;
+  const double count = static_cast<double>(v.size());
+  double sumV = 0.0;
+  for (double x : v) sumV += x;
+  // Under floor `lo` and cap `hi` the best allocation is n = clamp(c sigma, lo, hi) (Lagrange, with the
+  // box constraints active where they bind), c such that mean(n) = meanSpp; its mean relMSE:
+  auto relMseFor = [&](double lo, double hi) {
+    auto meanOf = [&](double c) {
+      double s = 0.0;
+      for (double x : v) s += std::clamp(c * std::sqrt(x), lo, hi);
+      return s / count;
+    };
+    double a = 0.0, b = 1.0;
+    while (meanOf(b) < meanSpp && b < 1e300) b *= 2.0;
+    for (int i = 0; i < 100; ++i) {
+      const double mid = 0.5 * (a + b);
+      (meanOf(mid) < meanSpp ? a : b) = mid;
+    }
+    double e = 0.0;
+    for (double x : v) e += x / std::clamp(b * std::sqrt(x), lo, hi);
+    return e / count;
+  };
+  double best = std::numeric_limits<double>::infinity();
+  if (maxSppRatio <= 0) {
+    best = relMseFor(minSpp, std::numeric_limits<double>::infinity());
+  } else {
+    // No tile more than maxSppRatio behind the most sampled: n in [hi / ratio, hi] with the floor at
+    // least minSpp and hi / ratio <= meanSpp <= hi. Scan the cap hi (log-spaced) for the least error.
+    for (int k = 0; k <= 400; ++k) {
+      const double hi = meanSpp * std::pow(static_cast<double>(maxSppRatio), k / 400.0);
+      const double lo = std::max(static_cast<double>(minSpp), hi / maxSppRatio);
+      if (lo <= meanSpp) best = std::min(best, relMseFor(lo, hi));
+    }
+  }
+  return (sumV / count / meanSpp) / best;
 }
 
 }  // namespace caustica

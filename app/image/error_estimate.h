@@ -47,6 +47,24 @@ double pixelChannelRelMse(double sumA, double nA, double sumB, double nB);
 // missed rare paths: a tile with fewer than `minSpp` samples, or less than 1/`maxSppRatio` of the most
 // sampled tile's, is live whatever its estimate; a tile whose gain is over 4x the mean makes its
 // neighbours within `dilation` tiles live (they may share its rare paths). NaN and +inf are live.
-std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, int minSpp, int maxSppRatio, int dilation);
+// `smoothing` in [0, 1]: the gain is taken from each tile's per-sample variance e n blended with the
+// mean over its 3x3 tile neighbourhood, (1 - smoothing) own + smoothing neighbourhood: a 4x4 tile's
+// own estimate swings with single bright samples and misses rare paths its neighbours share
+// (docs/adaptive-sampling.md, docs/benchmarks.md "Adaptive sampling": 0.5 allocates better).
+std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, int minSpp, int maxSppRatio, int dilation,
+                                     double smoothing = 0.0);
+
+// How much adaptive sampling can gain at all (docs/benchmarks.md, "Adaptive sampling"). `tileVariance`:
+// each tile's per-sample relative variance v (relMSE x samples per pixel under uniform sampling; tiles
+// of equal size). The image's mean relMSE, mean(v / n), is least for a given mean n when n is
+// proportional to sqrt(v); that allocation's gain over uniform sampling is mean(v) / mean(sqrt(v))^2.
+// 1 when every v is equal; NaN when every v is 0 or any is not finite.
+double adaptiveGainBound(const std::vector<double>& tileVariance);
+
+// The same best allocation under liveTiles' guards, at a mean of `meanSpp` samples per pixel: every
+// tile gets at least `minSpp` samples, and none has fewer than 1/`maxSppRatio` of the most sampled
+// tile's (the best such allocation is n = clamp(c sqrt(v), lo, hi) with hi <= maxSppRatio lo; found by
+// scanning hi). 1 when meanSpp <= minSpp (every tile then needs the minimum). maxSppRatio <= 0: no ratio guard.
+double guardedAdaptiveGainBound(const std::vector<double>& tileVariance, double meanSpp, int minSpp, int maxSppRatio);
 
 }  // namespace caustica

@@ -117,3 +117,57 @@ TEST_CASE("live tiles: the tiles whose error falls fastest per sample, with star
   e.tile[19] = std::nan("");
   CHECK(liveTiles(e, 16, 8, 0).size() == 2);  // NaN is never "below"
 }
+
+TEST_CASE("adaptive gain bound: mean(v) / mean(sqrt v)^2, and the same under the guards") {
+  CHECK(adaptiveGainBound({2.0, 2.0, 2.0}) == doctest::Approx(1.0));
+  // Two tiles, v = 1 and 9 (sigma 1 and 3): n ∝ sigma gains mean(v) / mean(sigma)^2 = 5 / 4.
+  CHECK(adaptiveGainBound({1.0, 9.0}) == doctest::Approx(1.25));
+  CHECK(std::isnan(adaptiveGainBound({0.0, 0.0})));
+  CHECK(std::isnan(adaptiveGainBound({1.0, std::numeric_limits<double>::infinity()})));
+  // Without binding guards the guarded bound is the bound: n = 50 and 150 at a mean of 100.
+  CHECK(guardedAdaptiveGainBound({1.0, 9.0}, 100.0, 16, 8) == doctest::Approx(1.25).epsilon(1e-6));
+  // The ratio guard binds: sigma 1 and 100 want n 1:100; with at most 8x, n = (100/8 c, 100 c).
+  // Mean 100 spp: c = 200 / 112.5; relMSE = (1 / n1 + 10^4 / n2) / 2; uniform (1 + 10^4) / 2 / 100.
+  {
+    const std::vector<double> v = {1.0, 1e4};
+    const double c = 200.0 / 112.5, n1 = c * 12.5, n2 = c * 100.0;
+    const double expected = ((1.0 + 1e4) / 2.0 / 100.0) / ((1.0 / n1 + 1e4 / n2) / 2.0);
+    // (the cap is scanned on a grid of 0.5 % steps: a relative tolerance of 1e-3)
+    CHECK(guardedAdaptiveGainBound(v, 100.0, 16, 8) / expected == doctest::Approx(1.0).epsilon(1e-3));
+    CHECK(guardedAdaptiveGainBound(v, 100.0, 1, 0) / adaptiveGainBound(v) == doctest::Approx(1.0).epsilon(1e-6));
+    // The minimum binds without the ratio guard: n1 = 16, n2 = 184.
+    CHECK(guardedAdaptiveGainBound(v, 100.0, 16, 0) / (((1.0 + 1e4) / 200.0) / ((1.0 / 16 + 1e4 / 184) / 2.0)) ==
+          doctest::Approx(1.0).epsilon(1e-6));
+  }
+  // The minimum binds: at a mean of 16 spp every tile needs its 16.
+  CHECK(guardedAdaptiveGainBound({1.0, 9.0}, 16.0, 16, 8) == 1.0);
+}
+
+TEST_CASE("live tiles: smoothing blends each tile's per-sample variance with its 3x3 neighbourhood") {
+  ErrorEstimate e;
+  e.tileSize = 4;
+  e.tilesX = 5;
+  e.tilesY = 5;
+  e.tile.assign(25, 0.001);
+  e.tileSppMin.assign(25, 32);
+  e.tile[12] = 1.0;  // the centre tile
+  // Without smoothing (and without dilation) only the centre is above the mean gain.
+  CHECK(liveTiles(e, 16, 8, 0, 0.0).size() == 1);
+  // With 0.5: per-sample variances 32 (centre), 0.032 (others); the centre's neighbours get
+  // 0.016 + 0.5 (32 + 8 x 0.032) / 9 = 1.81, above the mean (17.8 + 8 x 1.81 + 16 x 0.032) / 25 = 1.31,
+  // the far tiles 0.032 below it: the centre and its 8 neighbours.
+  auto live = liveTiles(e, 16, 8, 0, 0.5);
+  CHECK(live.size() == 9);
+  CHECK(live.front() == (1u | (1u << 16)));
+  CHECK(live.back() == (3u | (3u << 16)));
+  // Equal tiles stay equal: all live.
+  e.tile[12] = 0.001;
+  CHECK(liveTiles(e, 16, 8, 0, 0.5).size() == 25);
+  // A non-finite tile stays live but does not spread into its neighbours' variance: with the centre
+  // unknown and the corner noisy, the corner (20.0) and its neighbours (2.70, 2.70, 2.03) are above the
+  // mean of the finite tiles (1.17), the centre's other neighbours (0.032) below it.
+  e.tile[12] = std::numeric_limits<double>::infinity();
+  e.tile[0] = 1.0;
+  live = liveTiles(e, 16, 8, 0, 0.5);
+  CHECK(live == std::vector<std::uint32_t>{0u, 1u, 1u << 16, 1u | (1u << 16), 2u | (2u << 16)});
+}

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "image/error_estimate.h"
 #include "util/error.h"
 
 namespace caustica {
@@ -91,6 +92,31 @@ double referenceNoise(const Image& halfA, const Image& halfB, const PixelRect& r
   checkRegion(halfA, region, "reference noise");
   // A - M = (A - B) / 2, so mean((A - B)^2 / (M^2 + eps)) / 4 is the relMSE of A against M.
   return relMse(halfA, averageImages(halfA, halfB), region);
+}
+
+std::vector<double> tileRelVariance(const std::vector<float>& accum, const std::vector<float>& comp,
+                                    const std::vector<float>& half, const Image& reference, int tileSize) {
+  const size_t pixels = static_cast<size_t>(reference.width) * reference.height;
+  if (tileSize < 1 || accum.size() != pixels * 4 || comp.size() != pixels * 4 || half.size() != pixels * 4)
+    throw Error("tile variance: the render's images do not match the reference's size");
+  const int tilesX = (reference.width + tileSize - 1) / tileSize, tilesY = (reference.height + tileSize - 1) / tileSize;
+  std::vector<double> sum(static_cast<size_t>(tilesX) * tilesY, 0.0);
+  std::vector<int> count(sum.size(), 0);
+  for (int y = 0; y < reference.height; ++y)
+    for (int x = 0; x < reference.width; ++x) {
+      const size_t i = static_cast<size_t>(y) * reference.width + x;
+      const double n = double(accum[i * 4 + 3]) - double(comp[i * 4 + 3]), nB = half[i * 4 + 3];
+      double v = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        const double total = double(accum[i * 4 + c]) - double(comp[i * 4 + c]), r = reference.at(x, y, c);
+        v += pixelChannelVariance(total - half[i * 4 + c], n - nB, half[i * 4 + c], nB) * n / (r * r + kRelMseEpsilon);
+      }
+      const size_t t = static_cast<size_t>(y / tileSize) * tilesX + x / tileSize;
+      sum[t] += v / 3.0;
+      ++count[t];
+    }
+  for (size_t t = 0; t < sum.size(); ++t) sum[t] /= std::max(count[t], 1);
+  return sum;
 }
 
 Image averageImages(const Image& a, const Image& b) {

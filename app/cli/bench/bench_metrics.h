@@ -45,6 +45,14 @@ double relMse(const Image& image, const Image& reference, const PixelRect& regio
 // the estimate is mean((A - B)^2 / (M^2 + eps)) / 4 with M = (A + B) / 2.
 double referenceNoise(const Image& halfA, const Image& halfB);
 double referenceNoise(const Image& halfA, const Image& halfB, const PixelRect& region);
+// Each tileSize x tileSize tile's per-sample relative variance (row-major; edge tiles smaller), the input
+// of adaptiveGainBound (image/error_estimate.h): from a render's running sums (accum, comp, half as
+// error_estimate.h reads them: even and odd samples of each pixel), per pixel and channel the variance
+// of one sample, pixelChannelVariance x n, over reference^2 + eps (the bench's relMSE weight, from a
+// reference independent of the render: the render's own mean would be correlated with its variance
+// estimate and lower it where bright outliers are), averaged over channels and the tile's pixels.
+std::vector<double> tileRelVariance(const std::vector<float>& accum, const std::vector<float>& comp,
+                                    const std::vector<float>& half, const Image& reference, int tileSize);
 // (a + b) / 2 per value; throws Error when the sizes differ.
 Image averageImages(const Image& a, const Image& b);
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -103,7 +104,7 @@ class BenchRunner {
     ReferenceCache cache(cacheDir_, opts_.has("--refresh-reference"), setup_.glRenderer, quiet_);
     auto start = Clock::now();
     for (const auto& path : paths) benchScene(library, cache, path);
-    writeSummary(outDir_, summaryMarkdown(setup_, secondsSince(start), all_), quiet_);
+    if (!opts_.has("--adaptive-bound")) writeSummary(outDir_, summaryMarkdown(setup_, secondsSince(start), all_), quiet_);
     return 0;
   }
 
@@ -149,6 +150,13 @@ class BenchRunner {
                           ? givenReference(opts_.get("--reference", ""), settings.width, settings.height, quiet_)
                           : cache.get(library, ls, request, renderer);
       writeReferencePreview(outDir_, name, dispersionModeName(mode), ref.image, caustic);
+      if (opts_.has("--adaptive-bound")) {
+        RenderSettings run = settings;
+        run.dispersion = mode;
+        run.integrator = Integrator::Mis;
+        printAdaptiveBound(renderer, run, name, mode, ref);
+        continue;
+      }
       for (Integrator integrator : integrators_) {  // the cache left the renderer in the reference's settings
         RenderSettings run = settings;
         run.dispersion = mode;
@@ -160,11 +168,81 @@ class BenchRunner {
           results.push_back(measure(renderer, name, ref, caustic, true));
       }
     }
+    if (opts_.has("--adaptive-bound")) return;
     std::string csv = writeSceneCsv(outDir_, name, results);
     note(quiet_, "wrote " + csv);
     writePlot(outDir_, name, gnuplotScript(setup_, name, settings.width, settings.height, results),
               opts_.get("--gnuplot", "gnuplot"), quiet_);
     for (auto& r : results) all_.push_back(std::move(r));
+  }
+
+  // --adaptive-bound: one markdown table row per scene and mode on stdout (header before the first).
+  // Renders the measured settings uniformly to the reference's spp / 2 (--bound-spp) and takes each
+  // tile's per-sample variance from its even/odd halves, weighted by the reference (tileRelVariance).
+  // "uniform spp to 0.01" is mean(v) / 0.01, at which the guarded bounds are taken.
+  void printAdaptiveBound(Renderer& renderer, const RenderSettings& run, const std::string& name,
+                          DispersionMode mode, const Reference& ref) {
+    if (!boundHeader_)
+      std::printf("| scene | size | spp | uniform spp to 0.01 | bound 8x8 | bound 4x4 | 4x4, guards 16 spp & 8x | "
+                  "4x4, 16 spp & 32x | bound 2x2 | sampler's allocation at spp |\n"
+                  "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|\n");
+    boundHeader_ = true;
+    renderer.apply(run);
+    renderer.reset();
+    const int spp = opts_.getInt("--bound-spp", std::max(2, ref.spp / 2), 2, 1 << 24);
+    for (int done = 0; done < spp;) {
+      const int n = std::min(spp - done, std::max(1, renderer.samplesPerDispatch()));
+      renderer.renderPass(n);
+      done += n;
+    }
+    const AccumulationState st = renderer.saveAccumulation();
+    auto tiles = [&](int tile) { return tileRelVariance(st.accum, st.comp, st.half, ref.image, tile); };
+    const std::vector<double> v4 = tiles(4);
+    double meanV = 0.0;
+    for (double x : v4) meanV += x / static_cast<double>(v4.size());
+    const double spp01 = meanV / 0.01;
+    // The allocation adaptive sampling itself makes (AdaptiveSampler, this tile size and guards, another
+    // seed: independent of the variances), run to a mean of min(spp01, spp) samples per pixel; its
+    // expected relMSE mean(v / n) against uniform sampling's mean(v) / mean(n). Free of a single run's
+    // luck, which favours adaptive sampling where noise is heavy-tailed (docs/benchmarks.md).
+    AdaptiveSampler sampler(0.0, true);
+    const std::vector<double> vt = tiles(sampler.tileSize());
+    RenderSettings other = run;
+    other.seed = run.seed + 1;
+    renderer.apply(other);
+    renderer.reset();
+    const double pixels = double(ref.image.width) * ref.image.height, goal = std::min(spp01, double(spp));
+    for (int nextCheck = sampler.checkAtOrAfter(0); double(renderer.stats().primaryRays) < goal * pixels;) {
+      renderer.renderPass(std::max(1, std::min(renderer.samplesPerDispatch(), nextCheck - renderer.samplesPerPixel())));
+      if (renderer.samplesPerPixel() >= nextCheck) {
+        sampler.check(renderer);
+        if (sampler.done()) break;  // no live tile left (an image without noise)
+        nextCheck = sampler.checkAtOrAfter(renderer.samplesPerPixel() + 1);
+      }
+    }
+    const ErrorEstimate e = renderer.errorEstimate(sampler.tileSize());
+    renderer.useAllTiles();
+    {  // per tile (row-major): the per-sample variance and the sampler's samples, for other analyses
+      std::ofstream f(outDir_ + "/" + name + "-" + dispersionModeName(mode) + "-tile-variance.txt");
+      f << "# per tile of " << sampler.tileSize() << "x" << sampler.tileSize() << " pixels, row-major, " << e.tilesX
+        << " a row: per-sample relative variance (uniform render), the adaptive render's samples per pixel and its\n"
+        << "# own estimate of the per-sample variance (relMSE estimate x samples)\n";
+      for (size_t t = 0; t < vt.size(); ++t)
+        f << formatDouble("%.6g", vt[t]) << ' ' << e.tileSppMin[t] << ' ' << formatDouble("%.6g", e.tile[t] * e.tileSppMin[t])
+          << '\n';
+    }
+    double expected = 0.0, meanVt = 0.0;
+    for (size_t t = 0; t < vt.size(); ++t) {
+      expected += vt[t] / std::max(e.tileSppMin[t], 1) / double(vt.size());
+      meanVt += vt[t] / double(vt.size());
+    }
+    std::printf("| %s%s | %dx%d | %d | %.0f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f at %.0f |\n", name.c_str(),
+                mode == DispersionMode::Rgb ? "" : " (spectral)", ref.image.width, ref.image.height, spp, spp01,
+                adaptiveGainBound(tiles(8)), adaptiveGainBound(v4),
+                guardedAdaptiveGainBound(v4, spp01, kMinAdaptiveSpp, kMaxSppRatio),
+                guardedAdaptiveGainBound(v4, spp01, kMinAdaptiveSpp, 32), adaptiveGainBound(tiles(2)),
+                meanVt / e.sppMean / expected, e.sppMean);
+    std::fflush(stdout);
   }
 
   // One progressive run: renders in batches sized to land just past each checkpoint; the clock
@@ -258,6 +336,7 @@ class BenchRunner {
   std::vector<Integrator> integrators_, adaptiveIntegrators_;
   std::vector<DispersionMode> dispersions_;
   std::map<std::string, BenchSceneInfo> sceneInfo_;
+  bool boundHeader_ = false;    // --adaptive-bound: the table's header is printed
   std::vector<RunResult> all_;  // every run of every scene so far, for the summary
 };
 

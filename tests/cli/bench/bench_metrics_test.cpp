@@ -11,6 +11,7 @@
 
 #include "scene/assets.h"
 #include "cli/bench/bench_metrics.h"
+#include "image/error_estimate.h"
 #include "util/error.h"
 
 using namespace caustica;
@@ -283,4 +284,35 @@ TEST_CASE("CSV rows have one field per header column, quoted where needed") {
   CHECK(lines == 3);
   std::filesystem::remove(path);
   CHECK_THROWS_AS(writeBenchCsv("/nonexistent-dir/x.csv", {r}), Error);
+}
+
+TEST_CASE("tile variance: per-sample relative variance per tile from a render's halves, weighted by a reference") {
+  // 16x8 pixels, 64 samples each: 32 even ones of mean 1 + d and 32 odd ones (the half image) of mean
+  // 1 - d, d = 0.1 on the left 8 columns and 0.4 on the right. Var(mean) = (2d)^2 / (1/32 + 1/32) / 64
+  // = d^2, so the per-sample relative variance is 64 d^2 / (1 + 0.01) against a reference of 1, and
+  // the bound over the 4x4 tiles mean(v) / mean(sqrt v)^2 = ((0.01 + 0.16) / 2) / ((0.1 + 0.4) / 2)^2.
+  const int w = 16, h = 8;
+  std::vector<float> accum(size_t(w) * h * 4, 0.0f), comp = accum, half = accum;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      const float d = x < w / 2 ? 0.1f : 0.4f;
+      for (int c = 0; c < 3; ++c) {
+        half[i * 4 + c] = 32.0f * (1.0f - d);
+        accum[i * 4 + c] = half[i * 4 + c] + 32.0f * (1.0f + d);
+      }
+      half[i * 4 + 3] = 32.0f;
+      accum[i * 4 + 3] = 64.0f;
+    }
+  const std::vector<double> v = tileRelVariance(accum, comp, half, constantImage(w, h, 1.0f), 4);
+  REQUIRE(v.size() == size_t(4 * 2));
+  for (int t = 0; t < 8; ++t) {
+    const double d = t % 4 < 2 ? 0.1 : 0.4;
+    CHECK(relDiff(v[size_t(t)], 64.0 * d * d / 1.01) < 1e-5);
+  }
+  CHECK(relDiff(adaptiveGainBound(v), (0.17 / 2.0) / (0.25 * 0.25)) < 1e-5);
+  // The Kahan compensation is subtracted from the count: 32 of 64 leaves half A empty, the tile unknown.
+  comp[3] = 32.0f;
+  CHECK(std::isinf(tileRelVariance(accum, comp, half, constantImage(w, h, 1.0f), 4)[0]));
+  CHECK_THROWS_AS(tileRelVariance(accum, comp, half, constantImage(w, h + 1, 1.0f), 4), Error);
 }

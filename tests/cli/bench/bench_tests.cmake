@@ -1,5 +1,5 @@
-# bench_tests.cmake — tests of `caustica bench`: a smoke run of the
-# program on llvmpipe. Included by tests/CMakeLists.txt; run with `cmake -P` (CLI, OUT, GNUPLOT set)
+# bench_tests.cmake — tests of `caustica bench`: a smoke run of the program on llvmpipe (measured runs,
+# the reference cache, --adaptive-bound). Included by tests/CMakeLists.txt; run with `cmake -P` (CLI, OUT, GNUPLOT set)
 # this same file is the smoke check itself.
 
 if(CMAKE_SCRIPT_MODE_FILE)
@@ -66,6 +66,16 @@ if(CMAKE_SCRIPT_MODE_FILE)
   endif()
   if(NOT out2 MATCHES "\\| cornell-glass \\| mis \\| 16x16 \\|")
     message(FATAL_ERROR "the cached run printed no summary:\n${out2}")
+  endif()
+  # --adaptive-bound: no measured runs, one table row with finite bounds and the sampler's allocation.
+  execute_process(COMMAND ${CLI} ${args} --quiet --adaptive-bound --bound-spp 32 RESULT_VARIABLE rc OUTPUT_VARIABLE out3
+                  ERROR_VARIABLE err3)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "caustica bench --adaptive-bound failed (${rc}):\n${err3}")
+  endif()
+  if(NOT out3 MATCHES "\\| cornell-glass \\| 16x16 \\| 32 \\| [0-9]+ \\| [0-9.]+ \\| [0-9.]+ \\| [0-9.]+ \\| [0-9.]+ \\| [0-9.]+ \\| [0-9.]+ at [0-9]+ \\|"
+     OR NOT EXISTS ${OUT}/cornell-glass-rgb-tile-variance.txt)
+    message(FATAL_ERROR "--adaptive-bound printed no complete row or wrote no tile variances:\n${out3}")
   endif()
   return()
 endif()
