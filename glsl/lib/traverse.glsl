@@ -142,7 +142,8 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   // the closest hit (bvhVisitWide then enters none of its children, or its leaf's triangles fail the
   // t < hit.t test), so the hit is the same. On llvmpipe every indexed write of a local array is a
   // loop over the 8 lanes at each call site, and a pop that skips far subtrees is a loop: one word per
-  // push instead of two and one gather per pop measured 1.02-1.10x faster (docs/benchmarks.md, Session 5).
+  // push instead of two and one gather per pop: 0.97-1.09x the render speed, median 1.02x, on the
+  // bundled scenes (docs/benchmarks.md, Session 5, part 4).
   uint stackRef[CAUSTICA_BVH_WIDE_STACK];
   uint sp = 0u;
   uint ref = 0u;  // the root, an inner node
