@@ -62,7 +62,9 @@ int cmdInfo(const std::vector<std::string>& args) {
   double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t topNodes = ibvh.topNodeCount, allNodes = ibvh.nodes.size();
   t0 = std::chrono::steady_clock::now();
-  GpuScene g = instanced ? packInstancedScene(s, ibvh) : packScene(s, bvh);
+  // Flat scenes: the triangle records are not packed whole (as in render, which packs them in slices
+  // straight into the GPU blocks); their sizes are still known (gpuSceneBytes).
+  GpuScene g = instanced ? packInstancedScene(s, ibvh) : packScene(s, bvh, /*triangleArrays=*/false);
   const double packSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   std::printf("scene:      %s\n", s.path.c_str());
