@@ -35,16 +35,6 @@ GlLimits queryGlLimits() {
   return l;
 }
 
-namespace {
-
-std::string mib(double bytes) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
-  return buf;
-}
-
-}  // namespace
-
 void checkImageSize(const GlLimits& l, int w, int h) {
   if (w < 1 || h < 1) throw Error("image size must be at least 1x1");
   if (w > l.maxTextureSize || h > l.maxTextureSize)
@@ -52,12 +42,6 @@ void checkImageSize(const GlLimits& l, int w, int h) {
                 std::to_string(l.maxTextureSize));
   int gx = (w + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X, gy = (h + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y;
   if (gx > l.maxWorkGroupCount[0] || gy > l.maxWorkGroupCount[1]) throw Error("image too large for one compute dispatch");
-}
-
-void checkStorageSize(const GlLimits& l, const std::string& scenePath, const char* what, std::size_t bytes) {
-  if (static_cast<std::int64_t>(bytes) > l.maxStorageBlockSize)
-    throw Error(scenePath + ": " + what + " need " + mib(static_cast<double>(bytes)) + " but this GPU allows " +
-                mib(static_cast<double>(l.maxStorageBlockSize)) + " per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE)");
 }
 
 }  // namespace caustica

@@ -20,8 +20,5 @@ GlLimits queryGlLimits();
 
 // Throws Error unless a width x height accumulation image and its dispatch fit these limits.
 void checkImageSize(const GlLimits& limits, int width, int height);
-// Throws Error("SCENE: WHAT need X MiB but this GPU allows Y MiB per storage buffer ...") when
-// `bytes` exceed one storage buffer.
-void checkStorageSize(const GlLimits& limits, const std::string& scenePath, const char* what, std::size_t bytes);
 
 }  // namespace caustica

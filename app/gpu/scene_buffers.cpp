@@ -10,9 +10,11 @@
 namespace caustica {
 
 namespace {
+// Bytes as MiB, or KiB below 1 MiB (lowered test limits would read "0.0 MiB").
 std::string mib(double bytes) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
+  if (bytes < 1024.0 * 1024.0) std::snprintf(buf, sizeof buf, "%.1f KiB", bytes / 1024.0);
+  else std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
   return buf;
 }
 
@@ -78,9 +80,8 @@ SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, co
   l.texcoords = g.triShadeStride == gpu::kTriShadeWordsTextured;
   for (SplitArray* a : {&l.nodes, &l.triGeom}) a->perPart = std::max<std::size_t>(a->count, 1);
   planArray(l.triShade, limits.maxStorageBlockSize, g.triShadeStride, scenePath);
-  checkStorageSize(limits, scenePath, "materials", g.materials.size() * sizeof(gpu::Material));
-  checkStorageSize(limits, scenePath, "light tree", g.lightTree.nodes.size() * sizeof(gpu::LightNode));
-  checkStorageSize(limits, scenePath, "textures", (g.texels.size() + g.texInfo.size() * gpu::kTexInfoWords) * 4);
+  // Materials, the light tree and the texture block are read through buffer textures too
+  // (shading_textures.*, which refuses one over GL_MAX_TEXTURE_BUFFER_SIZE texels): no storage-block bound.
   const int blocks = CAUSTICA_SSBO_COUNT + l.extraBlocks();
   const int usable = std::min(limits.maxComputeStorageBlocks, limits.maxStorageBufferBindings);
   if (blocks > usable)

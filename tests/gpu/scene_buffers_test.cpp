@@ -22,13 +22,19 @@ struct ScopedEnv {
 };
 
 // A textured floor and a smooth sphere under a quad light: every array (nodes, TriGeom, TriShade with
-// texcoords) is large enough to split at a few KiB per block. 532 triangles.
-Scene splitScene() {
+// texcoords) is large enough to split at a few KiB per block. 532 triangles. The checker texture has
+// `checker` x `checker` texels (2: 16 bytes; 64: 16 KiB of texel words, more than a 10,000-byte block).
+Scene splitScene(int checkerSide = 2) {
   Scene s;
   Texture checker;
-  checker.width = checker.height = 2;
+  checker.width = checker.height = checkerSide;
   checker.nearest = true;
-  checker.rgba = {230, 230, 230, 255, 40, 90, 200, 255, 40, 90, 200, 255, 230, 230, 230, 255};
+  for (int y = 0; y < checkerSide; ++y)
+    for (int x = 0; x < checkerSide; ++x) {
+      static const unsigned char kLight[4] = {230, 230, 230, 255}, kBlue[4] = {40, 90, 200, 255};
+      const bool light = ((x * 2 / checkerSide) + (y * 2 / checkerSide)) % 2 == 0;  // 2x2 squares of any side
+      checker.rgba.insert(checker.rgba.end(), light ? kLight : kBlue, (light ? kLight : kBlue) + 4);
+    }
   s.textures.push_back(checker);
   Material floor;
   floor.baseColor = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
@@ -116,6 +122,21 @@ TEST_CASE("scene buffers: a scene split over several storage blocks renders the 
     CHECK(meanOf(whole.image) > 0.02);  // lit (measured 0.044): the comparison below is not of two black images
     CHECK(std::memcmp(split.image.rgb.data(), whole.image.rgb.data(), whole.image.rgb.size() * sizeof(float)) == 0);
   }
+}
+
+TEST_CASE("scene buffers: textures, materials and the light tree are not bound by the storage-block size") {
+  // They are read through buffer textures: a texture block larger than a storage block renders, and
+  // gives the same image as without the lowered limit (a storage-block check on them refused it).
+  const Scene scene = splitScene(64);
+  const SplitRender whole = render(scene, RenderMode::Path, 4);
+  SplitRender split;
+  {
+    ScopedEnv limit("CAUSTICA_MAX_SSBO_BYTES", "15000");
+    split = render(scene, RenderMode::Path, 4);
+  }
+  CHECK(scene.textures[0].rgba.size() > 15000);  // 64 x 64 texels of one word each
+  CHECK(meanOf(whole.image) > 0.02);
+  CHECK(std::memcmp(split.image.rgb.data(), whole.image.rgb.data(), whole.image.rgb.size() * sizeof(float)) == 0);
 }
 
 TEST_CASE("scene buffers: GL 4.3's 8 storage blocks still split the TriShade words in two") {
