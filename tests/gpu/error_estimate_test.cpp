@@ -17,11 +17,6 @@ using namespace caustica::test;
 
 namespace {
 
-ShaderLibrary& library() {
-  static ShaderLibrary lib;
-  return lib;
-}
-
 // Renders on until `spp` samples per pixel, at most 64 per pass.
 void renderTo(Renderer& r, int spp) {
   while (r.samplesPerPixel() < spp) r.renderPass(std::min(64, spp - r.samplesPerPixel()));
@@ -35,7 +30,7 @@ struct Reference {
 // The reference both comparisons measure against: `spp` samples with a seed no test render uses.
 Reference renderReference(const Scene& scene, const Camera& camera, RenderSettings rs, int spp) {
   rs.seed = 1234567;
-  Renderer ref(library(), scene, camera, rs);
+  Renderer ref(testShaderLibrary(), scene, camera, rs);
   renderTo(ref, spp);
   return {ref.image(), ref.errorEstimate().image};
 }
@@ -60,7 +55,7 @@ std::vector<EstimatePoint> estimateAgainstReference(const std::string& file, int
   const Image& reference = ref.image;
   const double referenceNoise = ref.noise;
   rs.seed = 1;
-  Renderer r(library(), scene, camera, rs);
+  Renderer r(testShaderLibrary(), scene, camera, rs);
   std::vector<EstimatePoint> out;
   for (int spp : spps) {
     renderTo(r, spp);
@@ -104,7 +99,7 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
   std::vector<std::string> perSeed(spps.size());
   for (int seed = 1; seed <= seeds; ++seed) {
     rs.seed = static_cast<std::uint32_t>(seed);
-    Renderer r(library(), scene, camera, rs);
+    Renderer r(testShaderLibrary(), scene, camera, rs);
     for (size_t k = 0; k < spps.size(); ++k) {
       renderTo(r, spps[k]);
       const double e = r.errorEstimate().image, m = relMse(r.image(), reference) - referenceNoise;
@@ -198,7 +193,7 @@ TEST_CASE("adaptive sampling: a pass samples exactly the pixels of the listed ti
   rs.width = 21;
   rs.height = 13;
   for (int side : {1, 2, 4, 8}) {
-    Renderer r(library(), scene, camera, rs);
+    Renderer r(testShaderLibrary(), scene, camera, rs);
     const int tx = (rs.width + side - 1) / side, ty = (rs.height + side - 1) / side;
     // Every third tile in row-major order, and the last (bottom-right, partial) one.
     std::vector<std::uint32_t> list;
@@ -240,13 +235,13 @@ TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
   rs.width = 48;
   rs.height = 48;
   rs.seed = 5;
-  Renderer uniform(library(), scene, camera, rs);
+  Renderer uniform(testShaderLibrary(), scene, camera, rs);
   while (uniform.samplesPerPixel() < 3072) uniform.renderPass(64);
   const ErrorEstimate eu = uniform.errorEstimate();
   for (int side : {8, 4, 2}) {
     INFO("adaptive tiles of " << side << "x" << side);
     rs.seed = 6;
-    Renderer adaptive(library(), scene, camera, rs);
+    Renderer adaptive(testShaderLibrary(), scene, camera, rs);
     AdaptiveSampler sampler(eu.image, true, kMinAdaptiveSpp, side);
     int next = sampler.checkAtOrAfter(0);
     while (!sampler.done() && adaptive.samplesPerPixel() < 16384) {
@@ -308,9 +303,9 @@ TEST_CASE("the all-features shader renders the specialised shader's image") {
     rs.width = 32;
     rs.height = 32;
     rs.seed = 11;
-    Renderer specialised(library(), scene, camera, rs);
+    Renderer specialised(testShaderLibrary(), scene, camera, rs);
     rs.allFeatures = true;
-    Renderer all(library(), scene, camera, rs);
+    Renderer all(testShaderLibrary(), scene, camera, rs);
     CHECK(all.shaderDefines().size() > specialised.shaderDefines().size());
     specialised.renderPass(64);
     all.renderPass(64);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -28,10 +29,15 @@ struct RenderResult {
   std::vector<std::string> defines;  // the shader variant that rendered it
 };
 
+// The embedded shaders, one library for every GL test (it holds no GL state: sources and expansion only).
+inline ShaderLibrary& testShaderLibrary() {
+  static ShaderLibrary library;
+  return library;
+}
+
 inline RenderResult renderScene(const Scene& scene, const Camera& camera, RenderSettings settings, int spp,
                                 int sppPerPass = 8) {
-  static ShaderLibrary library;
-  Renderer r(library, scene, camera, settings);
+  Renderer r(testShaderLibrary(), scene, camera, settings);
   while (r.samplesPerPixel() < spp) r.renderPass(std::min(sppPerPass, spp - r.samplesPerPixel()));
   return {r.image(), r.stats(), r.shaderDefines()};
 }
@@ -96,6 +102,19 @@ inline double meanOf(const Image& img, int channel = -1) {
       ++n;
     }
   return sum / static_cast<double>(n);
+}
+
+// Whether the shader variant `defines` holds `name` (the whole entry, value included).
+inline bool hasDefine(const std::vector<std::string>& defines, const std::string& name) {
+  return std::find(defines.begin(), defines.end(), name) != defines.end();
+}
+
+// Floats that differ between two arrays, bit for bit (0: equal; different sizes count every value).
+inline std::size_t differing(const std::vector<float>& a, const std::vector<float>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) n += std::memcmp(&a[i], &b[i], sizeof(float)) != 0;
+  return n;
 }
 
 }  // namespace caustica::test

@@ -79,10 +79,6 @@ Camera testCamera() {
   return c;
 }
 
-bool hasDefine(const std::vector<std::string>& d, const std::string& name) {
-  return std::find(d.begin(), d.end(), name) != d.end();
-}
-
 // Per-block channel means of an image (bx x by blocks).
 std::vector<double> blockMeans(const Image& img, int bx, int by) {
   std::vector<double> sum(std::size_t(bx * by * 3), 0.0), n(sum.size(), 0.0);
@@ -165,7 +161,7 @@ TEST_CASE("instancing: 64 instances of a sphere keep one sphere on the GPU") {
   s.instances.push_back({1, placed({9, 6, 9}, 0.0, {1, 0, 0}, {10, 1, 10})});  // facing down
   s.bounds.grow(glm::vec3(-1, -1, -1));
   s.bounds.grow(glm::vec3(19, 6, 19));
-  static ShaderLibrary library;
+  ShaderLibrary& library = testShaderLibrary();
   RenderSettings settings;
   settings.width = settings.height = 8;
   Renderer r(library, s, autoCamera(s.bounds), settings);

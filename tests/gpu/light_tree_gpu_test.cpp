@@ -61,7 +61,7 @@ void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& node
     in.push_back(glm::uvec4(q.node, 0u, 0u, 0u));
     qs.push_back(q);
   }
-  static ShaderLibrary library;
+  ShaderLibrary& library = testShaderLibrary();
   ExpandedShader src = library.expand("tests/light_tree_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
                                              "light_tree_test.comp");

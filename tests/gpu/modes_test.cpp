@@ -294,7 +294,7 @@ TEST_CASE("render modes: pointLightIntensity and phongBrdf agree with their C++ 
     lights.push_back(l);
     args.push_back(a);
   }
-  static ShaderLibrary library;
+  ShaderLibrary& library = testShaderLibrary();
   ExpandedShader src = library.expand("tests/modes_twins_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
                                              "modes_twins_test.comp");

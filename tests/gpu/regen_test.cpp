@@ -15,19 +15,6 @@ using namespace caustica::test;
 
 namespace {
 
-ShaderLibrary& library() {
-  static ShaderLibrary lib;
-  return lib;
-}
-
-// Bits that differ between two float arrays (0: equal bit for bit).
-size_t differing(const std::vector<float>& a, const std::vector<float>& b) {
-  if (a.size() != b.size()) return a.size() + b.size();
-  size_t n = 0;
-  for (size_t i = 0; i < a.size(); ++i) n += std::memcmp(&a[i], &b[i], sizeof(float)) != 0;
-  return n;
-}
-
 // Renders `passes` (samples per pass) with `perDispatch` samples per dispatch; with `tiles`, the
 // second and later passes run on those live tiles only (adaptive sampling).
 struct Run {
@@ -38,7 +25,7 @@ struct Run {
 Run render(const Scene& scene, const Camera& camera, RenderSettings rs, int perDispatch, const std::vector<int>& passes,
            const std::vector<std::uint32_t>& tiles = {}) {
   rs.samplesPerDispatch = perDispatch;
-  Renderer r(library(), scene, camera, rs);
+  Renderer r(testShaderLibrary(), scene, camera, rs);
   for (size_t i = 0; i < passes.size(); ++i) {
     if (i == 1 && !tiles.empty()) r.setLiveTiles(tiles);
     r.renderPass(passes[i]);
@@ -150,7 +137,7 @@ TEST_CASE("path regeneration: samples per dispatch stay within llvmpipe's loop c
     rs.maxDepth = depth;
     rs.samplesPerDispatch = wanted;
     rs.mode = mode;
-    return Renderer(library(), scene, sceneCamera(scene), rs).samplesPerDispatch();
+    return Renderer(testShaderLibrary(), scene, sceneCamera(scene), rs).samplesPerDispatch();
   };
   CHECK(perDispatch(256, 0) == 4);    // the default depth: 4 * 256 bounces
   CHECK(perDispatch(1024, 0) == 1);   // the deepest: one sample
@@ -161,7 +148,7 @@ TEST_CASE("path regeneration: samples per dispatch stay within llvmpipe's loop c
   CHECK(perDispatch(16, 0, RenderMode::Whitted) == 1);  // whitted.comp: one sample per dispatch
   Scene cut = cutoutScene();  // alpha pass-throughs (up to 256 per sample) count against the bound
   RenderSettings rs = small(Integrator::Mis);
-  CHECK(Renderer(library(), cut, frontCamera(), rs).samplesPerDispatch() == 2);
+  CHECK(Renderer(testShaderLibrary(), cut, frontCamera(), rs).samplesPerDispatch() == 2);
 }
 
 TEST_CASE("path regeneration: deep paths lose no energy at the largest samples per dispatch asked for") {
@@ -180,7 +167,7 @@ TEST_CASE("path regeneration: deep paths lose no energy at the largest samples p
     rs.width = rs.height = 16;
     rs.maxDepth = depth;
     rs.samplesPerDispatch = 64;
-    Renderer r(library(), scene, sceneCamera(scene), rs);
+    Renderer r(testShaderLibrary(), scene, sceneCamera(scene), rs);
     r.renderPass(spp);
     AccumulationState st = r.saveAccumulation();
     int shortCount = 0;
@@ -203,12 +190,11 @@ TEST_CASE("specialisation: a scene without emitters leaves the emitter estimate 
   scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
   const Camera camera = sceneCamera(scene);
   RenderSettings rs = small(Integrator::Mis, 3);
-  Renderer specialised(library(), scene, camera, rs);
+  Renderer specialised(testShaderLibrary(), scene, camera, rs);
   rs.allFeatures = true;
-  Renderer all(library(), scene, camera, rs);
-  const auto has = [](const std::vector<std::string>& d) { return std::find(d.begin(), d.end(), "CAUSTICA_NO_EMITTERS") != d.end(); };
-  CHECK(has(specialised.shaderDefines()));
-  CHECK_FALSE(has(all.shaderDefines()));
+  Renderer all(testShaderLibrary(), scene, camera, rs);
+  CHECK(hasDefine(specialised.shaderDefines(), "CAUSTICA_NO_EMITTERS"));
+  CHECK_FALSE(hasDefine(all.shaderDefines(), "CAUSTICA_NO_EMITTERS"));
   specialised.renderPass(8);
   all.renderPass(8);
   const AccumulationState a = specialised.saveAccumulation(), b = all.saveAccumulation();

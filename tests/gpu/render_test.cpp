@@ -220,7 +220,7 @@ TEST_CASE("Renderer::apply: a renderer whose settings changed renders what a new
   // size, estimator, depth, seed and caster aiming on an existing renderer, the image must equal a
   // fresh renderer's with those settings (same variant, same accumulation restart).
   Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
-  static ShaderLibrary library;
+  ShaderLibrary& library = testShaderLibrary();
   RenderSettings first = small(12, 10, Integrator::Naive, 3);
   RenderSettings second = small(16, 12, Integrator::Mis, 9);
   second.maxDepth = 7;
@@ -343,9 +343,8 @@ TEST_CASE("mis aiming at the glass ball (caustic casters) matches naive and find
       blockStats(scene, cam, Integrator::Mis, n, n, block, 64, renders, 400, &nonFinite, 32, 0.5f, &aimedDefines);
   BlockStats plain =
       blockStats(scene, cam, Integrator::Mis, n, n, block, 64, renders, 500, &nonFinite, 32, 0.0f, &plainDefines);
-  auto has = [](const std::vector<std::string>& d) { return std::count(d.begin(), d.end(), "CAUSTICA_CASTERS") > 0; };
-  REQUIRE(has(aimedDefines));
-  REQUIRE_FALSE(has(plainDefines));
+  REQUIRE(hasDefine(aimedDefines, "CAUSTICA_CASTERS"));
+  REQUIRE_FALSE(hasDefine(plainDefines, "CAUSTICA_CASTERS"));
   checkBlocksAgree("caustic scene, naive against mis with casters", naive, aimed);
   checkBlocksAgree("caustic scene, mis without casters against mis with casters", plain, aimed);
   CHECK(nonFinite == 0);

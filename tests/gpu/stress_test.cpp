@@ -386,7 +386,7 @@ TEST_CASE("stress: long run: 100,000 samples per pixel of a furnace stay exact")
   RenderSettings settings;
   settings.width = settings.height = 4;
   settings.integrator = Integrator::Mis;
-  static ShaderLibrary library;
+  ShaderLibrary& library = testShaderLibrary();
   // Per-sample standard deviation of one pixel, from short independent renders.
   std::vector<double> means;
   for (std::uint32_t seed = 100; seed < 164; ++seed) {

@@ -202,7 +202,7 @@ TEST_CASE("transparent background: PNG holds straight alpha, EXR premultiplied R
 }
 
 TEST_CASE("transparent background: a checkpoint keeps the coverage: 8 + 8 spp equals 16 spp bit for bit") {
-  static ShaderLibrary library;
+  ShaderLibrary& library = testShaderLibrary();
   const Scene scene = wallAndBall(Background::Kind::Transparent);
   const RenderSettings rs = settings(Integrator::Mis, 5);
   Renderer straight(library, scene, frontCamera(), rs);

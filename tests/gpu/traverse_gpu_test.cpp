@@ -47,7 +47,7 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std
   GlBuffer rayBuf = GlBuffer::fromVector(rays);
   GlBuffer hitBuf = GlBuffer::create(sizeof(glm::vec4) * rayCount, nullptr);
   GlBuffer occBuf = GlBuffer::create(sizeof(std::uint32_t) * rayCount, nullptr);
-  static ShaderLibrary lib;
+  ShaderLibrary& lib = test::testShaderLibrary();
   ExpandedShader src = lib.expand("tests/trace_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
   prog.use();
@@ -293,7 +293,7 @@ TEST_CASE("instanced GPU traversal (traverse_instanced.glsl) equals its C++ twin
   GlBuffer rayBuf = GlBuffer::fromVector(rays);
   GlBuffer hitBuf = GlBuffer::create(sizeof(glm::uvec4) * rayCount, nullptr);
   GlBuffer occBuf = GlBuffer::create(sizeof(glm::uvec2) * rayCount, nullptr);
-  static ShaderLibrary lib;
+  ShaderLibrary& lib = test::testShaderLibrary();
   ExpandedShader src = lib.expand("tests/trace_instanced_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); },
                                              "tests/trace_instanced_test.comp");
