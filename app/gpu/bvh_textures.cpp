@@ -10,11 +10,11 @@
 
 namespace caustica {
 
-void checkBufferTextureTexels(std::size_t texels, const std::string& what) {
+void checkBufferTextureTexels(std::size_t texels, const std::string& what, const std::string& arrayNeeds) {
   GLint maxTexels = 0;
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
   if (texels > static_cast<std::size_t>(maxTexels))
-    throw Error(what + ": the BVH needs " + std::to_string(texels) + " texels in one buffer texture; this GL offers " +
+    throw Error(what + ": " + arrayNeeds + " " + std::to_string(texels) + " texels in one buffer texture; this GL offers " +
                 std::to_string(maxTexels) + " (GL_MAX_TEXTURE_BUFFER_SIZE)");
 }
 

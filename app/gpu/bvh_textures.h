@@ -11,8 +11,9 @@
 
 namespace caustica {
 
-// Throws Error naming `what` when `texels` (16-byte RGBA32UI texels) exceed GL_MAX_TEXTURE_BUFFER_SIZE.
-void checkBufferTextureTexels(std::size_t texels, const std::string& what);
+// Throws Error("WHAT: ARRAY_NEEDS N texels in one buffer texture; ...") when `texels` exceed
+// GL_MAX_TEXTURE_BUFFER_SIZE; `what` is the scene's path, `arrayNeeds` e.g. "the materials need".
+void checkBufferTextureTexels(std::size_t texels, const std::string& what, const std::string& arrayNeeds = "the BVH needs");
 
 class BvhTextures {
  public:

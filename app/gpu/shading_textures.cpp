@@ -3,6 +3,7 @@
 
 #include <cstddef>
 
+#include "gpu/bvh_textures.h"  // checkBufferTextureTexels
 #include "shared/gpu_layout.h"
 #include "util/error.h"
 
@@ -10,18 +11,12 @@ namespace caustica {
 
 ShadingTextures::ShadingTextures(const GlBuffer& materials, const GlBuffer& lightNodes, const GlBuffer& texels,
                                  const GlBuffer* triShade, const std::string& what) {
-  GLint maxTexels = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
   const struct {
     const char* name;
     std::size_t texels;
   } views[] = {{"materials", materials.size() / 16}, {"light tree", lightNodes.size() / 16}, {"textures", texels.size() / 4},
                    {"triangle shading data", triShade ? triShade->size() / 12 : 0}};
-  for (const auto& v : views)
-    if (v.texels > static_cast<std::size_t>(maxTexels))
-      throw Error(what + ": the " + v.name + " need " + std::to_string(v.texels) +
-                  " texels in one buffer texture; this GL offers " + std::to_string(maxTexels) +
-                  " (GL_MAX_TEXTURE_BUFFER_SIZE)");
+  for (const auto& v : views) checkBufferTextureTexels(v.texels, what, std::string("the ") + v.name + " need");
   materials_ = GlBufferTexture::create(materials, GL_RGBA32UI);
   lightNodes_ = GlBufferTexture::create(lightNodes, GL_RGBA32UI);
   texels_ = GlBufferTexture::create(texels, GL_R32UI);

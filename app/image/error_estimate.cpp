@@ -122,7 +122,7 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
       v = (1.0 - smoothing) * v + smoothing * sum / k;  // k >= 1: the tile itself is finite
     }
     const double n = std::max(e.tileSppMin[t], 1);
-    gain[t] = v / (n * n);  // = e / n without smoothing
+    gain[t] = smoothing > 0.0 ? v / (n * n) : e.tile[t] / n;  // e / n exactly without smoothing
     if (std::isfinite(gain[t])) {
       meanGain += gain[t];
       ++finite;

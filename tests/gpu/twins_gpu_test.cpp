@@ -572,7 +572,7 @@ TEST_CASE("GLSL floorMod and wrapCoord equal their C++ twins bit for bit (textur
   Random r(13);
   std::vector<In> in;
   auto add = [&](int i, int n) { in.push_back(uints({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(n), 0, 0})); };
-  for (int n : {1, 2, 3, 7, 255, 256, 1023, 4096, 16384})
+  for (int n : {1, 2, 3, 7, 255, 256, 1023, 4096, 16384, (1 << 19) + 1, (1 << 20) - 1, 1 << 20})  // up to the claimed 2^20
     for (int i : {0, -1, 1, 10000001, -10000001, 9999999, -9999999, n - 1, n, n + 1, -n - 1, -n, -n + 1, 2 * n - 1, 2 * n,
                   -2 * n, 10000000 / n * n, -(10000000 / n * n) - 1})
       add(i, n);

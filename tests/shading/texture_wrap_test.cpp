@@ -1,6 +1,6 @@
 // texture_wrap_test.cpp — floorMod and wrapCoord (app/shading/texture_wrap.*, twins of
 // glsl/lib/texture_wrap.glsl) against integer arithmetic: every i near the multiples of n, the extremes
-// of the clamped texel coordinate (+-1e7 + 1) and random values, for small and large n.
+// of the clamped texel coordinate (+-1e7 + 1) and random values, for small and large n (up to the claimed 2^20).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -27,7 +27,7 @@ TEST_CASE("floorMod and wrapCoord equal the integer-division forms, also at the 
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> any(-10000001, 10000001);
   int checked = 0, wrong = 0;
-  for (int n : {1, 2, 3, 7, 64, 255, 256, 1000, 1023, 4096, 16383, 16384}) {
+  for (int n : {1, 2, 3, 7, 64, 255, 256, 1000, 1023, 4096, 16383, 16384, (1 << 19) + 1, (1 << 20) - 1, 1 << 20}) {
     std::vector<int> is = {0, -1, 1, 10000001, -10000001, 10000000, -10000000, 9999999, -9999999};
     for (int k = -40; k <= 40; ++k)
       for (int d = -2; d <= 2; ++d) is.push_back(k * n + d);
