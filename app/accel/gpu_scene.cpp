@@ -165,6 +165,24 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
 }
 
 namespace {
+// An emissive triangle's weight for the emitter choice: luminance(emission) * area * sides (area in
+// scene units^2 from its vertices p[3]); 0 where that is not a positive finite number (no emitter).
+double emitterWeight(const Material& m, const glm::vec3* p) {
+  const double area = 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  const double w = static_cast<double>(luminance(glm::max(m.emission, glm::vec3(0.0f)))) * area * (m.doubleSided ? 2.0 : 1.0);
+  return w > 0.0 && std::isfinite(w) ? w : 0.0;
+}
+
+// The light tree's item for emitter `tri` (TriGeom index) with vertices p[3] and weight `power`.
+LightTreeItem emitterItem(std::uint32_t tri, const glm::vec3* p, double power, bool twoSided) {
+  LightTreeItem item;
+  item.tri = tri;
+  for (int k = 0; k < 3; ++k) item.v[k] = p[k];
+  item.power = power;
+  item.twoSided = twoSided;
+  return item;
+}
+
 // What packScene and packInstancedScene share: features, environment, materials, punctual lights,
 // textures (not the triangles, the casters or the emitters).
 void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
@@ -247,21 +265,12 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
     const Triangle& tri = scene.triangles[bvh.order[i]];
     const Material& m = scene.materials[tri.material];
     if (!m.isEmissive()) continue;
-    const glm::vec3* t = tri.p;  // TriGeom's vertices
-    double area = 0.5 * glm::length(glm::cross(t[1] - t[0], t[2] - t[0]));
-    double w = static_cast<double>(luminance(glm::max(m.emission, glm::vec3(0.0f)))) * area * (m.doubleSided ? 2.0 : 1.0);
-    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    const double w = emitterWeight(m, tri.p);  // tri.p: TriGeom's vertices
+    if (w == 0.0) continue;
     weights.push_back(w);
     tris.push_back(static_cast<std::uint32_t>(i));
     totalWeight += w;
-    LightTreeItem item;
-    item.tri = static_cast<std::uint32_t>(i);
-    item.v[0] = t[0];
-    item.v[1] = t[1];
-    item.v[2] = t[2];
-    item.power = w;
-    item.twoSided = m.doubleSided;
-    lightItems.push_back(item);
+    lightItems.push_back(emitterItem(static_cast<std::uint32_t>(i), tri.p, w, m.doubleSided));
   }
   // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
   // TriGeom.v1.w (leaf index + 1 as uint bits, 0: not in the tree).
@@ -337,20 +346,13 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     const Triangle& tri = lights.triangles[e];
     const Material& m = scene.materials[tri.material];
     if (!m.isEmissive()) continue;
-    const glm::vec3* t = tri.p;
-    double area = 0.5 * glm::length(glm::cross(t[1] - t[0], t[2] - t[0]));
-    double w = static_cast<double>(luminance(glm::max(m.emission, glm::vec3(0.0f)))) * area * (m.doubleSided ? 2.0 : 1.0);
-    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    const double w = emitterWeight(m, tri.p);
+    if (w == 0.0) continue;
     weights.push_back(w);
     items.push_back(static_cast<std::uint32_t>(lightItems.size()));
     totalWeight += w;
-    LightTreeItem item;
-    item.tri = storedIndex[source[e].triangle];
-    item.instance = source[e].instance;
-    for (int k = 0; k < 3; ++k) item.v[k] = t[k];
-    item.power = w;
-    item.twoSided = m.doubleSided;
-    lightItems.push_back(item);
+    lightItems.push_back(emitterItem(storedIndex[source[e].triangle], tri.p, w, m.doubleSided));
+    lightItems.back().instance = source[e].instance;
   }
   g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);  // per stored triangle: meaningless here
