@@ -118,6 +118,18 @@ std::uint32_t floatBits(float f) {
   return u;
 }
 
+// Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, stride): its octahedral normals, then
+// full-float texcoords only where textures read them (half floats would move a texel on large textures).
+void writeTriShade(const Scene& scene, std::size_t tri, std::uint32_t stride, std::uint32_t* w) {
+  for (int k = 0; k < 3; ++k) w[k] = scene.triangles[tri].normalWord[k];  // stored octahedral already (scene.h)
+  if (stride == gpu::kTriShadeWordsTextured)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec2 uv = triangleUv(scene, tri, k);
+      w[3 + 2 * k] = floatBits(uv.x);
+      w[4 + 2 * k] = floatBits(uv.y);
+    }
+}
+
 // The environment's texels, CDFs and UBO. An environment lights every point from everywhere, so
 // refractive casters are aimed at from every point: the sphere around the lights becomes one that
 // holds every point (its squared radius still finite in float).
@@ -151,16 +163,7 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
     geom[j].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
     geom[j].v1 = glm::vec4(t.p[1], glm::uintBitsToFloat(leaf == gpu::kInvalidIndex ? 0u : leaf + 1u));
     geom[j].v2 = glm::vec4(t.p[2], 0.0f);
-    // Shading words (gpu_layout.h): octahedral normals, then full-float texcoords only where textures
-    // read them (half floats would move a texel on large textures).
-    std::uint32_t* w = shade.data() + j * g.triShadeStride;
-    for (int k = 0; k < 3; ++k) w[k] = t.normalWord[k];  // stored octahedral already (scene.h)
-    if (g.triShadeStride == gpu::kTriShadeWordsTextured)
-      for (int k = 0; k < 3; ++k) {
-        const glm::vec2 uv = triangleUv(scene, bvh.order[i], k);
-        w[3 + 2 * k] = floatBits(uv.x);
-        w[4 + 2 * k] = floatBits(uv.y);
-      }
+    writeTriShade(scene, bvh.order[i], g.triShadeStride, shade.data() + j * g.triShadeStride);
   }
 }
 
@@ -325,16 +328,8 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   for (std::size_t x = 0; x < g.triangleCount; ++x) {
     const std::uint32_t i = bvh.triSource[x];
     storedIndex[i] = static_cast<std::uint32_t>(x);
-    const Triangle& t = scene.triangles[i];
     g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
-    std::uint32_t* w = g.triShade.data() + x * g.triShadeStride;
-    for (int k = 0; k < 3; ++k) w[k] = t.normalWord[k];  // stored octahedral already (scene.h)
-    if (g.triShadeStride == gpu::kTriShadeWordsTextured)
-      for (int k = 0; k < 3; ++k) {
-        const glm::vec2 uv = triangleUv(scene, i, k);
-        w[3 + 2 * k] = floatBits(uv.x);
-        w[4 + 2 * k] = floatBits(uv.y);
-      }
+    writeTriShade(scene, i, g.triShadeStride, g.triShade.data() + x * g.triShadeStride);
   }
 
   // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
