@@ -392,8 +392,8 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     sh.row2 = glm::vec4(w[0][2], w[1][2], w[2][2], w[3][2]);
     sh.lightLeafBase = leafBase[i];
     sh.flags = glm::determinant(glm::dmat3(in.world)) < 0.0 ? gpu::kInstanceMirrored : 0u;
-    g.instancedTriangles += scene.meshes[in.mesh].triangleCount;
   }
+  g.instancedTriangles = instancedTriangleCount(scene);
   append(shades.data(), shades.size() * sizeof(gpu::InstanceShade));
   g.lightLeafTableTexel = static_cast<std::uint32_t>(g.nodes.size() * (sizeof(gpu::BvhNode) / 16));
   append(table.data(), table.size() * sizeof(std::uint32_t));

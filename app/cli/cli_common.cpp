@@ -323,8 +323,7 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
 
 void flattenForRaster(Scene& scene, const Options& opts, bool quiet) {
   if (scene.instances.empty()) return;
-  std::uint64_t placed = 0;
-  for (const Instance& in : scene.instances) placed += scene.meshes[in.mesh].triangleCount;
+  const std::uint64_t placed = instancedTriangleCount(scene);
   const std::uint64_t limit = loadOptionsFrom(opts).maxTriangles;
   if (placed > limit)
     throw Error(scene.path + ": the raster mode draws flattened scenes, and flattening its " +

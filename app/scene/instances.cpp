@@ -54,8 +54,7 @@ void flattenInstances(Scene& scene) {
   std::vector<Triangle> out;
   std::vector<TriangleUv> outUv;  // only where the scene keeps texture coordinates
   const bool uv = !scene.texcoords.empty();
-  std::size_t total = 0;
-  for (const Instance& in : scene.instances) total += scene.meshes[in.mesh].triangleCount;
+  const std::size_t total = instancedTriangleCount(scene);
   out.reserve(total);
   if (uv) outUv.reserve(total);
   for (const Instance& in : scene.instances) flattenInstance(scene, in, out, nullptr, nullptr, uv ? &outUv : nullptr);
@@ -65,6 +64,14 @@ void flattenInstances(Scene& scene) {
   scene.instances.clear();
 }
 
+std::uint64_t instancedTriangleCount(const Scene& scene) {
+  std::uint64_t n = 0;
+  for (const Instance& in : scene.instances) n += scene.meshes[in.mesh].triangleCount;
+  return n;
+}
+
+namespace {
+// Per mesh: how many of its triangles have materialWanted[material].
 std::vector<std::uint64_t> wantedPerMesh(const Scene& scene, const std::vector<bool>& materialWanted) {
   std::vector<std::uint64_t> n(scene.meshes.size(), 0);
   for (std::size_t m = 0; m < scene.meshes.size(); ++m)
@@ -74,6 +81,7 @@ std::vector<std::uint64_t> wantedPerMesh(const Scene& scene, const std::vector<b
     }
   return n;
 }
+}  // namespace
 
 std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& materialWanted) {
   const std::vector<std::uint64_t> perMesh = wantedPerMesh(scene, materialWanted);

@@ -216,6 +216,8 @@ Scene flattenedSubset(const Scene& scene, const std::vector<bool>& materialWante
                       std::vector<InstancedTriangle>* source = nullptr);
 // How many triangles flattenedSubset(scene, materialWanted) would make (zero-area ones included).
 std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& materialWanted);
+// How many triangles the instances place in all (what flattenInstances makes, zero-area ones included).
+std::uint64_t instancedTriangleCount(const Scene& scene);
 
 // Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const LoadOptions& options);
