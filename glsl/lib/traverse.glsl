@@ -24,7 +24,9 @@
 // by entry distance (a 5-exchange network): the nearest is visited next, the others stacked (refs
 // only), nearest on top — the same order as the C++ twin's, so ties between equal t resolve the same
 // way. A popped subtree beyond the closest hit so far is not skipped on the stack: its node visit
-// enters none of its children (their boxes end before hit.t), so no distances are stacked.
+// enters none of its children (their boxes end before hit.t), so no distances are stacked. The stack's
+// top eight refs are kept in registers and the inner loop never indexes the local array (see
+// BVH_INNER_STEP; docs/benchmarks.md, "Session 6").
 
 struct Hit {
   float t;   // distance along dir (units of |dir|)
