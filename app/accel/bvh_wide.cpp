@@ -95,7 +95,9 @@ BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
       --count;
       addChildren(opened, best);  // ...and put its two children in its place
     }
-    // The traversal writes up to three stack slots from sp on at every inner node, then keeps count - 1.
+    // The traversal writes up to three stack slots from sp on at every inner node, then keeps count - 1
+    // (the GLSL moves four entries from its registers to its array only when it holds six or more, so
+    // the total it holds is the same).
     out.stackNeed = std::max(out.stackNeed, w.stackBefore + 3);
     out.depth = std::max(out.depth, w.depth);
     gpu::BvhWideNode n = emptyWideNode();
@@ -161,7 +163,9 @@ Hit traverseWide(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<g
   if (nodes.empty()) return hit;
   const glm::vec3 invDir = raybox::safeInverse(ray.dir);
   const RayShear rs = makeRayShear(ray.dir);
-  float closest = tmax;
+  // At most 3e38, as the shaders' tmax: an empty slot's box at +inf is entered by an infinite tmax, which
+  // would stack more than stackNeed.
+  float closest = std::min(tmax, 3.0e38f);
   std::uint32_t stackRef[CAUSTICA_BVH_WIDE_STACK];
   std::uint32_t sp = 0;
   std::uint32_t ref = 0;  // the root, an inner node

@@ -13,7 +13,7 @@ namespace caustica {
 struct BvhWide {
   std::vector<gpu::BvhWideNode> nodes;  // nodes[0] is the root; depth-first order, parents first
   int depth = 0;        // deepest level of wide nodes (root = 1)
-  int stackNeed = 0;    // most stack entries the traversal can hold (<= CAUSTICA_BVH_WIDE_STACK - 2, checked)
+  int stackNeed = 0;    // most stack entries the traversal can hold (<= CAUSTICA_BVH_WIDE_STACK, checked)
 };
 
 // Collapses the binary tree (Bvh::nodes: gpu::BvhNode, both children's boxes and refs per inner node,
@@ -25,8 +25,9 @@ struct BvhWide {
 BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary);
 
 // Closest hit with t in (0, tmax) through the 4-wide nodes. Twin of traceClosest() in traverse.glsl.
+// tmax is clamped to 3e38, as the shaders' callers pass it (an empty slot's box lies at +inf).
 Hit traceClosest(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriGeom>& tris,
-                 const Ray& ray, float tmax = std::numeric_limits<float>::infinity());
+                 const Ray& ray, float tmax = 3.0e38f);
 
 // Any hit with t in (0, tmax). Twin of traceOccluded() in traverse.glsl.
 bool traceOccluded(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriGeom>& tris,

@@ -9,7 +9,7 @@
 //   BvhWideNode i = texels 7i..7i+6 of bvhWideTexels: minX, maxX, minY, maxY, minZ, maxZ (component k =
 //     child k, float bits, world space), then the four child refs. A ref is a wide node's index (bit 31
 //     clear) or a leaf as in BvhNode; an unused slot is kBvhEmptyRef with a box at +inf, never entered.
-//     bvhWideTexels' node 0 is the root. Stack use is bounded by packBvhWideNodes (< CAUSTICA_BVH_WIDE_STACK).
+//     bvhWideTexels' node 0 is the root. Stack use is bounded by packBvhWideNodes (<= CAUSTICA_BVH_WIDE_STACK).
 //   BvhNode i = texels 4i..4i+3 of bvhNodeTexels: (lmin, left ref), (lmax, 0), (rmin, right ref),
 //     (rmax, 0); boxes as float bits in world space. A ref with kBvhLeafBit clear is an inner node's
 //     index; else a leaf over triGeom[first .. first + count - 1] (first = ref & kBvhFirstMask,
@@ -82,8 +82,8 @@ void bvhSortPair(inout float ta, inout uint ra, inout float tb, inout uint rb) {
 
 // min and max for operands that are never NaN, as selects: GLSL min/max compile on llvmpipe to
 // vminps/vmaxps plus a NaN test and a masked move (its NaN-safe min/max); `a < b ? a : b` is one
-// vminps. The slab distances below are never NaN: invDir is finite and nonzero (safeInverse, unit
-// directions), boxes are finite or +inf (empty slots), so (bound - org) * invDir is a number or +-inf.
+// vminps. The slab distances below are never NaN: invDir is finite and nonzero (safeInverse of a unit
+// direction without NaN components), boxes are finite or +inf (empty slots), so (bound - org) * invDir is a number or +-inf.
 // Where a and b are zeros of both signs the result's sign may differ from min/max; the distances are
 // only compared, never used as values, so the traversal is the same.
 // `precise` keeps NIR from folding the select back into fmin/fmax (its rule is for inexact selects).
@@ -155,8 +155,8 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
 // lane's inner loop as an empty leaf with the node kept in pendNode; the outer loop then moves the
 // bottom four registers to the array and the node is visited again. The array is read only when the
 // registers are empty, also in the outer loop. One stack (LIFO) all the same: the same order of visits
-// as the C++ twin's. Both are rare (bundled scenes: at most 0.001 overflows and 0.004 array pops per
-// ray, docs/benchmarks.md "Session 6"), but each array access site costs on every pass of its loop.
+// as the C++ twin's. Both are rare (measured on five bundled scenes: at most 0.001 overflows and 0.004 array
+// pops per ray, docs/benchmarks.md "Session 6"), but each array access site costs on every pass of its loop.
 
 // Pushes r.y, r.z, r.w (the first k, 0..3; r.y on top) onto the register stack (a, b).
 void bvhRegPush(inout uvec4 a, inout uvec4 b, uvec4 r, uint k) {
