@@ -36,6 +36,15 @@ double defaultVarianceSmoothing() {
   return w;
 }
 
+TileVariance defaultTileVariance() {
+  const char* v = std::getenv("CAUSTICA_ADAPTIVE_VARIANCE");
+  if (v == nullptr || *v == '\0') return kTileVariance;
+  const std::string s(v);
+  if (s == "halves") return TileVariance::Halves;
+  if (s == "moments") return TileVariance::Moments;
+  throw Error("CAUSTICA_ADAPTIVE_VARIANCE must be 'halves' or 'moments', not '" + s + "'");
+}
+
 AdaptiveSampler::AdaptiveSampler(double targetError, bool adaptive, int minSpp, int tileSize)
     : target_(targetError), adaptive_(adaptive), minSpp_(std::max(2, minSpp)), tileSize_(tileSize) {
   if (tileSize != 1 && tileSize != 2 && tileSize != 4 && tileSize != 8) throw Error("adaptive tile size must be 1, 2, 4 or 8");
@@ -51,7 +60,7 @@ const ErrorEstimate& AdaptiveSampler::check(Renderer& renderer) {
   estimate_ = renderer.errorEstimate(tileSize_);
   liveTiles_ = renderer.liveTileCount();
   if (adaptive_) {
-    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, maxSppRatio_, kTileDilation, smoothing_);
+    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, maxSppRatio_, kTileDilation, smoothing_, variance_);
     renderer.setLiveTiles(live, tileSize_);
     liveTiles_ = live.size();
   }

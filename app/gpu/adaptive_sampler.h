@@ -13,6 +13,7 @@ constexpr int kMinAdaptiveSpp = 16;  // no tile stops before every pixel has thi
 constexpr int kTileDilation = 1;     // a tile with over 4x the mean gain keeps its 8 neighbours live
 constexpr int kMaxSppRatio = 8;      // no tile falls behind the most sampled one by more than this factor
 constexpr double kVarianceSmoothing = 0.5;  // weight of the 3x3 tile neighbourhood in a tile's variance (liveTiles)
+constexpr TileVariance kTileVariance = TileVariance::Moments;  // per-tile variance the allocation uses (liveTiles)
 constexpr int kAdaptiveTile = 4;     // side of the tiles in pixels (1, 2, 4 or 8): 4 pays best (docs/benchmarks.md)
 
 // kAdaptiveTile, or the environment variable CAUSTICA_ADAPTIVE_TILE (1, 2, 4 or 8) where set: a knob
@@ -24,6 +25,9 @@ int defaultMaxSppRatio();
 // kVarianceSmoothing, or the environment variable CAUSTICA_ADAPTIVE_SMOOTHING (a number in [0, 1]) where
 // set: a knob to measure the smoothing with (0 = each tile's own estimate). Throws Error otherwise.
 double defaultVarianceSmoothing();
+// kTileVariance, or the environment variable CAUSTICA_ADAPTIVE_VARIANCE ("halves" or "moments") where
+// set: a knob to measure the two per-tile variance estimates with. Throws Error otherwise.
+TileVariance defaultTileVariance();
 
 class AdaptiveSampler {
  public:
@@ -51,6 +55,7 @@ class AdaptiveSampler {
   int tileSize_;
   int maxSppRatio_ = defaultMaxSppRatio();
   double smoothing_ = defaultVarianceSmoothing();
+  TileVariance variance_ = defaultTileVariance();
   ErrorEstimate estimate_;
   std::size_t liveTiles_ = 0;
   bool done_ = false;

@@ -15,13 +15,32 @@ double pixelChannelVariance(double sumA, double nA, double sumB, double nB) {
   return d * d / (1.0 / nA + 1.0 / nB) / n;
 }
 
+double pixelChannelMomentVariance(double m2, double n) {
+  if (!(n >= 2.0)) return std::numeric_limits<double>::infinity();
+  return m2 / (n - 1.0) / n;
+}
+
+std::vector<float> momentsFromHalves(const std::vector<float>& accum, const std::vector<float>& comp,
+                                     const std::vector<float>& half) {
+  std::vector<float> m2(accum.size(), 0.0f);
+  for (size_t i = 0; i + 3 < accum.size() && i + 3 < comp.size() && i + 3 < half.size(); i += 4) {
+    const double n = double(accum[i + 3]) - double(comp[i + 3]), nB = half[i + 3], nA = n - nB;
+    if (!(nA > 0.0 && nB > 0.0)) continue;
+    for (int ch = 0; ch < 3; ++ch) {
+      const double total = double(accum[i + ch]) - double(comp[i + ch]);
+      m2[i + ch] = static_cast<float>(n * (n - 1.0) * pixelChannelVariance(total - half[i + ch], nA, half[i + ch], nB));
+    }
+  }
+  return m2;
+}
+
 double pixelChannelRelMse(double sumA, double nA, double sumB, double nB) {
   const double m = (sumA + sumB) / (nA + nB);
   return pixelChannelVariance(sumA, nA, sumB, nB) / (m * m + kErrorEpsilon);
 }
 
 ErrorEstimate estimateError(int width, int height, const std::vector<float>& accum, const std::vector<float>& comp,
-                            const std::vector<float>& half, int tileSize) {
+                            const std::vector<float>& half, int tileSize, const std::vector<float>& moment) {
   ErrorEstimate e;
   e.width = width;
   e.height = height;
@@ -34,6 +53,8 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   e.tileSppMin.assign(e.tile.size(), std::numeric_limits<int>::max());
   std::vector<int> tilePixels(e.tile.size(), 0);
   if (pixels == 0 || accum.size() < pixels * 4 || comp.size() < pixels * 4 || half.size() < pixels * 4) return e;
+  const bool moments = moment.size() >= pixels * 4;
+  if (moments) e.tileMoment.assign(e.tile.size(), 0.0);
   // Pixel means first. The denominator is the median of three estimates of the pixel's true mean:
   // its own mean m (correlated with (mA - mB)^2: a bright outlier raises both, and alone it
   // underestimates skewed pixels, 0.58x at 8 spp on the Cornell box at 24x24), the mean of its 8
@@ -41,7 +62,7 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   // overestimated 1.7-7.7x, a dark pixel beside the light underestimated ~0.75x) and the lower of its
   // two half means (an outlier sits in one half only; biased low by the halves' noise). Each is wrong
   // in a different case, and in each case the other two agree (docs/adaptive-sampling.md).
-  std::vector<double> mean(pixels * 3), var(pixels * 3), lowHalf(pixels * 3);
+  std::vector<double> mean(pixels * 3), var(pixels * 3), lowHalf(pixels * 3), momentVar(moments ? pixels * 3 : 0);
   std::vector<int> count(pixels);
   for (size_t i = 0; i < pixels; ++i) {
     const float* a = &accum[i * 4];
@@ -55,6 +76,7 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
       mean[i * 3 + ch] = n > 0.0 ? total / n : 0.0;
       lowHalf[i * 3 + ch] = nA > 0.0 && nB > 0.0 ? std::min((total - b[ch]) / nA, double(b[ch]) / nB) : 0.0;
       var[i * 3 + ch] = pixelChannelVariance(total - b[ch], nA, b[ch], nB);
+      if (moments) momentVar[i * 3 + ch] = pixelChannelMomentVariance(moment[i * 4 + ch], n);
     }
   }
   double sum = 0.0, sppSum = 0.0;
@@ -62,7 +84,7 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
-      double rel = 0.0;
+      double rel = 0.0, relMoment = 0.0;
       for (int ch = 0; ch < 3; ++ch) {
         double m = 0.0;
         int k = 0;
@@ -77,8 +99,10 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
         const double own = mean[i * 3 + ch], low = lowHalf[i * 3 + ch];
         m = std::max(std::min(own, m), std::min(std::max(own, m), low));
         rel += var[i * 3 + ch] / (m * m + kErrorEpsilon);
+        if (moments) relMoment += momentVar[i * 3 + ch] / (m * m + kErrorEpsilon);
       }
       rel /= 3.0;
+      if (moments) e.tileMoment[static_cast<size_t>(y / tileSize) * e.tilesX + x / tileSize] += relMoment / 3.0;
       e.pixel[i] = static_cast<float>(rel);
       sum += rel;
       const int spp = count[i];
@@ -91,18 +115,21 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
       e.tileSppMin[t] = std::min(e.tileSppMin[t], spp);
     }
   for (size_t t = 0; t < e.tile.size(); ++t) e.tile[t] /= std::max(tilePixels[t], 1);
+  for (size_t t = 0; t < e.tileMoment.size(); ++t) e.tileMoment[t] /= std::max(tilePixels[t], 1);
   e.image = sum / static_cast<double>(pixels);
   e.sppMean = sppSum / static_cast<double>(pixels);
   return e;
 }
 
 std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int maxSppRatio, int dilation,
-                                     double smoothing) {
+                                     double smoothing, TileVariance variance) {
   const size_t tiles = e.tile.size();
+  const std::vector<double>& tileRel =
+      variance == TileVariance::Moments && e.tileMoment.size() == tiles ? e.tileMoment : e.tile;
   // Each tile's per-sample variance v = e n, blended with the mean over its 3x3 neighbourhood (finite
   // values only; non-finite ones stay as they are and keep the tile live).
   std::vector<double> perSample(tiles), gain(tiles);
-  for (size_t t = 0; t < tiles; ++t) perSample[t] = e.tile[t] * std::max(e.tileSppMin[t], 1);
+  for (size_t t = 0; t < tiles; ++t) perSample[t] = tileRel[t] * std::max(e.tileSppMin[t], 1);
   double meanGain = 0.0;
   int mostSpp = 0, finite = 0;
   for (size_t t = 0; t < tiles; ++t) {
@@ -122,7 +149,7 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
       v = (1.0 - smoothing) * v + smoothing * sum / k;  // k >= 1: the tile itself is finite
     }
     const double n = std::max(e.tileSppMin[t], 1);
-    gain[t] = smoothing > 0.0 ? v / (n * n) : e.tile[t] / n;  // e / n exactly without smoothing
+    gain[t] = smoothing > 0.0 ? v / (n * n) : tileRel[t] / n;  // e / n exactly without smoothing
     if (std::isfinite(gain[t])) {
       meanGain += gain[t];
       ++finite;
