@@ -122,13 +122,13 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
 }
 
 std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int maxSppRatio, int dilation,
-                                     double smoothing, TileVariance variance) {
+                                     double smoothing, TileVariance variance, double targetMeanSpp) {
   const size_t tiles = e.tile.size();
   const std::vector<double>& tileRel =
       variance == TileVariance::Moments && e.tileMoment.size() == tiles ? e.tileMoment : e.tile;
   // Each tile's per-sample variance v = e n, blended with the mean over its 3x3 neighbourhood (finite
   // values only; non-finite ones stay as they are and keep the tile live).
-  std::vector<double> perSample(tiles), gain(tiles);
+  std::vector<double> perSample(tiles), gain(tiles), smoothed(tiles);
   for (size_t t = 0; t < tiles; ++t) perSample[t] = tileRel[t] * std::max(e.tileSppMin[t], 1);
   double meanGain = 0.0;
   int mostSpp = 0, finite = 0;
@@ -149,6 +149,7 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
       v = (1.0 - smoothing) * v + smoothing * sum / k;  // k >= 1: the tile itself is finite
     }
     const double n = std::max(e.tileSppMin[t], 1);
+    smoothed[t] = v;
     gain[t] = smoothing > 0.0 ? v / (n * n) : tileRel[t] / n;  // e / n exactly without smoothing
     if (std::isfinite(gain[t])) {
       meanGain += gain[t];
@@ -159,6 +160,21 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
   // Slightly below the mean, so that tiles of equal gain all count as "at the mean" despite rounding.
   meanGain = meanGain / std::max(finite, 1) * (1.0 - 1e-9);
   std::vector<char> live(tiles, 0);
+  if (targetMeanSpp > 0.0) {
+    // Target rule: the guarded allocation for the finite tiles' smoothed variances at targetMeanSpp.
+    std::vector<double> v;
+    for (size_t t = 0; t < tiles; ++t)
+      if (std::isfinite(smoothed[t])) v.push_back(std::max(smoothed[t], 0.0));
+    const std::vector<double> goal = guardedAllocation(v, targetMeanSpp, minSpp, maxSppRatio, 60);
+    size_t k = 0, count = 0;
+    for (size_t t = 0; t < tiles; ++t) {
+      const bool behind = e.tileSppMin[t] < minSpp || static_cast<double>(e.tileSppMin[t]) * maxSppRatio < mostSpp;
+      const bool below = std::isfinite(smoothed[t]) ? e.tileSppMin[t] < goal[k++] : true;
+      live[t] = behind || below;
+      count += live[t];
+    }
+    if (count == 0) live.assign(tiles, 1);
+  } else
   for (int ty = 0; ty < e.tilesY; ++ty)
     for (int tx = 0; tx < e.tilesX; ++tx) {
       const size_t t = static_cast<size_t>(ty) * e.tilesX + tx;
@@ -189,44 +205,70 @@ double adaptiveGainBound(const std::vector<double>& v) {
   return (sumV / n) / ((sumSigma / n) * (sumSigma / n));
 }
 
-double guardedAdaptiveGainBound(const std::vector<double>& v, double meanSpp, int minSpp, int maxSppRatio) {
-  const double bound = adaptiveGainBound(v);
-  if (!std::isfinite(bound)) return bound;
-  if (meanSpp <= minSpp) return 1.0;
+std::vector<double> guardedAllocation(const std::vector<double>& v, double meanSpp, int minSpp, int maxSppRatio,
+                                      int steps) {
+  std::vector<double> uniform(v.size(), meanSpp);
+  for (double x : v)
+    if (!std::isfinite(x) || x < 0.0) return uniform;
+  if (v.empty() || meanSpp <= minSpp) return uniform;
   const double count = static_cast<double>(v.size());
-  double sumV = 0.0;
-  for (double x : v) sumV += x;
+  std::vector<double> sigma(v.size());
+  for (size_t i = 0; i < v.size(); ++i) sigma[i] = std::sqrt(v[i]);
   // Under floor `lo` and cap `hi` the best allocation is n = clamp(c sigma, lo, hi) (Lagrange, with the
   // box constraints active where they bind), c such that mean(n) = meanSpp; its mean relMSE:
-  auto relMseFor = [&](double lo, double hi) {
+  auto allocationFor = [&](double lo, double hi, std::vector<double>& n) {
     auto meanOf = [&](double c) {
       double s = 0.0;
-      for (double x : v) s += std::clamp(c * std::sqrt(x), lo, hi);
+      for (double x : sigma) s += std::clamp(c * x, lo, hi);
       return s / count;
     };
     double a = 0.0, b = 1.0;
     while (meanOf(b) < meanSpp && b < 1e300) b *= 2.0;
-    for (int i = 0; i < 100; ++i) {
+    for (int i = 0; i < 100 && b - a > 1e-12 * b; ++i) {
       const double mid = 0.5 * (a + b);
       (meanOf(mid) < meanSpp ? a : b) = mid;
     }
     double e = 0.0;
-    for (double x : v) e += x / std::clamp(b * std::sqrt(x), lo, hi);
+    for (size_t i = 0; i < v.size(); ++i) {
+      n[i] = std::clamp(b * sigma[i], lo, hi);
+      e += v[i] / n[i];
+    }
     return e / count;
   };
-  double best = std::numeric_limits<double>::infinity();
+  std::vector<double> best = uniform, n(v.size());
+  double bestError = std::numeric_limits<double>::infinity();
+  auto consider = [&](double lo, double hi) {
+    const double e = allocationFor(lo, hi, n);
+    if (e < bestError) {
+      bestError = e;
+      best = n;
+    }
+  };
   if (maxSppRatio <= 0) {
-    best = relMseFor(minSpp, std::numeric_limits<double>::infinity());
+    consider(minSpp, std::numeric_limits<double>::infinity());
   } else {
     // No tile more than maxSppRatio behind the most sampled: n in [hi / ratio, hi] with the floor at
     // least minSpp and hi / ratio <= meanSpp <= hi. Scan the cap hi (log-spaced) for the least error.
-    for (int k = 0; k <= 400; ++k) {
-      const double hi = meanSpp * std::pow(static_cast<double>(maxSppRatio), k / 400.0);
+    for (int k = 0; k <= steps; ++k) {
+      const double hi = meanSpp * std::pow(static_cast<double>(maxSppRatio), double(k) / steps);
       const double lo = std::max(static_cast<double>(minSpp), hi / maxSppRatio);
-      if (lo <= meanSpp) best = std::min(best, relMseFor(lo, hi));
+      if (lo <= meanSpp) consider(lo, hi);
     }
   }
-  return (sumV / count / meanSpp) / best;
+  return best;
+}
+
+double guardedAdaptiveGainBound(const std::vector<double>& v, double meanSpp, int minSpp, int maxSppRatio) {
+  const double bound = adaptiveGainBound(v);
+  if (!std::isfinite(bound)) return bound;
+  if (meanSpp <= minSpp) return 1.0;
+  const std::vector<double> n = guardedAllocation(v, meanSpp, minSpp, maxSppRatio);
+  double sumV = 0.0, e = 0.0;
+  for (size_t i = 0; i < v.size(); ++i) {
+    sumV += v[i];
+    e += v[i] / n[i];
+  }
+  return (sumV / meanSpp) / e;
 }
 
 }  // namespace caustica

@@ -72,8 +72,23 @@ double pixelChannelRelMse(double sumA, double nA, double sumB, double nB);
 // own estimate swings with single bright samples and misses rare paths its neighbours share
 // (docs/adaptive-sampling.md, docs/benchmarks.md "Adaptive sampling": 0.5 allocates better).
 // `variance`: which per-tile estimate (above).
+// `targetMeanSpp` > 0 selects the *target rule* instead of the gain rule: the tiles live are those with
+// fewer samples than the guarded allocation with the least mean relMSE for their (smoothed) per-sample
+// variances at a mean of `targetMeanSpp` samples (guardedAllocation below; the sampler passes the mean
+// it expects at its next check). The gain rule follows the noise of the estimates between tiles of
+// equal variance; the target's floor (>= 1/maxSppRatio of its cap) flattens it and its cap lets the
+// noisiest tiles reach maxSppRatio x the floor (docs/benchmarks.md, "Adaptive sampling", session 6).
+// `dilation` is not used by the target rule; the minSpp and ratio guards and NaN / +inf tiles are.
+// When no tile is below its target (rounding), every tile is live.
 std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, int minSpp, int maxSppRatio, int dilation,
-                                     double smoothing = 0.0, TileVariance variance = TileVariance::Halves);
+                                     double smoothing = 0.0, TileVariance variance = TileVariance::Halves,
+                                     double targetMeanSpp = 0.0);
+
+// The allocation guardedAdaptiveGainBound scores: n = clamp(c sqrt(v), lo, hi) with lo >= minSpp,
+// hi <= maxSppRatio lo, mean(n) = meanSpp, the cap hi scanned over `steps` log-spaced values for the
+// least mean(v / n). Every n = meanSpp when meanSpp <= minSpp or the v are not all finite and >= 0.
+std::vector<double> guardedAllocation(const std::vector<double>& tileVariance, double meanSpp, int minSpp,
+                                      int maxSppRatio, int steps = 400);
 
 // How much adaptive sampling can gain at all (docs/benchmarks.md, "Adaptive sampling"). `tileVariance`:
 // each tile's per-sample relative variance v (relMSE x samples per pixel under uniform sampling; tiles
