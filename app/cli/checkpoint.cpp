@@ -1,6 +1,6 @@
-// checkpoint.cpp — checkpoint file format: a text header after the magic line, then the four images'
-// raw floats (sums, Kahan compensation, odd-sample half, second moments; versions 2-3: no moments) and,
-// with "coverage 1", the coverage image's (native little-endian), protected by an FNV-1a 64 checksum.
+// checkpoint.cpp — checkpoint file format: a text header after the magic line, then the three images'
+// raw floats (sums, Kahan compensation, odd-sample half) and, with "coverage 1", the coverage image's
+// (native little-endian), protected by an FNV-1a 64 checksum.
 #include "cli/checkpoint.h"
 
 #include <cerrno>
@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "cli/bench/bench_metrics.h"
-#include "image/error_estimate.h"
 #include "util/error.h"
 #include "util/file_io.h"
 
@@ -42,7 +41,6 @@ std::uint64_t dataHash(const AccumulationState& st) {
   std::uint64_t h = fnv1a64(st.accum.data(), st.accum.size() * sizeof(float));
   h = fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
   h = fnv1a64(st.half.data(), st.half.size() * sizeof(float), h);
-  h = fnv1a64(st.moment.data(), st.moment.size() * sizeof(float), h);  // empty (no change) before version 4
   return st.coverage.empty() ? h : fnv1a64(st.coverage.data(), st.coverage.size() * sizeof(float), h);
 }
 
@@ -62,8 +60,7 @@ std::map<std::string, std::string> parseLines(const std::string& text) {
 void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
   const AccumulationState& st = ck.state;
   const size_t n = static_cast<size_t>(st.width) * st.height * 4;
-  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n || st.moment.size() != n ||
-      (!st.coverage.empty() && st.coverage.size() != n / 4))
+  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n || (!st.coverage.empty() && st.coverage.size() != n / 4))
     throw Error("internal: checkpoint images do not match its size");
   std::ostringstream h;
   h << kCheckpointMagic << ' ' << kCheckpointVersion << '\n'
@@ -85,7 +82,6 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     out.write(reinterpret_cast<const char*>(st.accum.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.comp.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.half.data()), static_cast<std::streamsize>(n * sizeof(float)));
-    out.write(reinterpret_cast<const char*>(st.moment.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.coverage.data()), static_cast<std::streamsize>(st.coverage.size() * sizeof(float)));
     out.close();
     if (!out) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
@@ -117,7 +113,6 @@ Checkpoint readCheckpoint(const std::string& path) {
     throw bad("version " + head[kCheckpointMagic] + " (this caustica reads versions " +
               std::to_string(kCheckpointOldestVersion) + " to " + std::to_string(kCheckpointVersion) + ")");
   const bool coverage = version >= 3 && num("coverage") != 0;  // version 2: opaque renders only
-  const bool moments = version >= 4;  // versions 2-3: no moment image (estimated from the halves below)
   Checkpoint ck;
   AccumulationState& st = ck.state;
   unsigned long long w = num("width"), hgt = num("height"), settingsBytes = num("settings");
@@ -135,8 +130,7 @@ Checkpoint readCheckpoint(const std::string& path) {
   ck.settingsText = bytes.substr(settingsLineEnd + 1, settingsBytes);
   const size_t dataAt = end + 5;
   const size_t n = static_cast<size_t>(w) * hgt * 4;
-  const size_t images = moments ? 4 : 3;
-  const size_t dataBytes = (images * n + (coverage ? n / 4 : 0)) * sizeof(float);
+  const size_t dataBytes = (3 * n + (coverage ? n / 4 : 0)) * sizeof(float);
   if (bytes.size() != dataAt + dataBytes)
     throw bad("holds " + std::to_string(bytes.size() - dataAt) + " bytes of image data, expected " +
               std::to_string(dataBytes) + " (truncated?)");
@@ -146,19 +140,11 @@ Checkpoint readCheckpoint(const std::string& path) {
   std::memcpy(st.accum.data(), bytes.data() + dataAt, n * sizeof(float));
   std::memcpy(st.comp.data(), bytes.data() + dataAt + n * sizeof(float), n * sizeof(float));
   std::memcpy(st.half.data(), bytes.data() + dataAt + 2 * n * sizeof(float), n * sizeof(float));
-  if (moments) {
-    st.moment.resize(n);
-    std::memcpy(st.moment.data(), bytes.data() + dataAt + 3 * n * sizeof(float), n * sizeof(float));
-  }
   if (coverage) {
     st.coverage.resize(n / 4);
-    std::memcpy(st.coverage.data(), bytes.data() + dataAt + images * n * sizeof(float), n / 4 * sizeof(float));
+    std::memcpy(st.coverage.data(), bytes.data() + dataAt + 3 * n * sizeof(float), n / 4 * sizeof(float));
   }
   if (dataHash(st) != expected) throw bad("the image data fails its checksum (corrupted)");
-  // Before version 4: each pixel's sum of squared deviations estimated from its two halves (unbiased,
-  // one degree of freedom per channel, as the halves' own estimate): the resumed render's adaptive
-  // decisions then differ from an uninterrupted one's, the image's mean does not.
-  if (!moments) st.moment = momentsFromHalves(st.accum, st.comp, st.half);
   return ck;
 }
 

@@ -14,13 +14,11 @@ constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
 // 2: adds the odd-sample half image (error estimate, adaptive sampling); version 1 files are refused.
 // 3: adds a "coverage 0|1" header line and, with 1, the r32f coverage image after the three others
 // (--background transparent); version 2 files still load (no coverage: opaque renders).
-// 4: adds the rgba32f moment image (per-pixel sums of squared deviations, adaptive sampling) after the
-// half image; version 2-3 files still load, their moments estimated from the halves (momentsFromHalves).
-constexpr int kCheckpointVersion = 4;
+constexpr int kCheckpointVersion = 3;
 constexpr int kCheckpointOldestVersion = 2;
 
 struct Checkpoint {
-  AccumulationState state;        // the four rgba32f images (+ coverage), spp and the next global sample index
+  AccumulationState state;        // the three rgba32f images (+ coverage), spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
   std::string settingsText;       // checkpointSettingsText(...)

@@ -36,24 +36,6 @@ double defaultVarianceSmoothing() {
   return w;
 }
 
-TileVariance defaultTileVariance() {
-  const char* v = std::getenv("CAUSTICA_ADAPTIVE_VARIANCE");
-  if (v == nullptr || *v == '\0') return kTileVariance;
-  const std::string s(v);
-  if (s == "halves") return TileVariance::Halves;
-  if (s == "moments") return TileVariance::Moments;
-  throw Error("CAUSTICA_ADAPTIVE_VARIANCE must be 'halves' or 'moments', not '" + s + "'");
-}
-
-AllocationRule defaultAllocationRule() {
-  const char* v = std::getenv("CAUSTICA_ADAPTIVE_RULE");
-  if (v == nullptr || *v == '\0') return kAllocationRule;
-  const std::string s(v);
-  if (s == "gain") return AllocationRule::Gain;
-  if (s == "target") return AllocationRule::Target;
-  throw Error("CAUSTICA_ADAPTIVE_RULE must be 'gain' or 'target', not '" + s + "'");
-}
-
 AdaptiveSampler::AdaptiveSampler(double targetError, bool adaptive, int minSpp, int tileSize)
     : target_(targetError), adaptive_(adaptive), minSpp_(std::max(2, minSpp)), tileSize_(tileSize) {
   if (tileSize != 1 && tileSize != 2 && tileSize != 4 && tileSize != 8) throw Error("adaptive tile size must be 1, 2, 4 or 8");
@@ -69,12 +51,7 @@ const ErrorEstimate& AdaptiveSampler::check(Renderer& renderer) {
   estimate_ = renderer.errorEstimate(tileSize_);
   liveTiles_ = renderer.liveTileCount();
   if (adaptive_) {
-    // The target rule aims at the allocation for the mean the next check will see if every tile were
-    // live: the mean now scaled as the passes grow to the next check.
-    const int spp = renderer.samplesPerPixel(), next = checkAtOrAfter(spp + 1);
-    const double target = rule_ == AllocationRule::Target && spp > 0 ? estimate_.sppMean * next / spp : 0.0;
-    std::vector<std::uint32_t> live =
-        caustica::liveTiles(estimate_, minSpp_, maxSppRatio_, kTileDilation, smoothing_, variance_, target);
+    std::vector<std::uint32_t> live = caustica::liveTiles(estimate_, minSpp_, maxSppRatio_, kTileDilation, smoothing_);
     renderer.setLiveTiles(live, tileSize_);
     liveTiles_ = live.size();
   }

@@ -272,7 +272,6 @@ void Renderer::allocateImages() {
   accum_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   comp_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   half_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
-  moment_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   coverage_ = transparent_ ? GlTexture::create2D(settings_.width, settings_.height, GL_R32F) : GlTexture();
   const int tiles = ((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X) *
                     ((settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
@@ -286,7 +285,6 @@ void Renderer::reset() {
   accum_.clear();
   comp_.clear();
   half_.clear();
-  moment_.clear();
   if (transparent_) coverage_.clear();
   useAllTiles();
   spp_ = 0;
@@ -351,7 +349,7 @@ std::size_t Renderer::liveTileCount() const {
 
 ErrorEstimate Renderer::errorEstimate(int tileSize) const {
   return estimateError(settings_.width, settings_.height, accum_.readRgba32f(), comp_.readRgba32f(), half_.readRgba32f(),
-                       tileSize, moment_.readRgba32f());
+                       tileSize);
 }
 
 namespace {
@@ -403,7 +401,6 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);
-  moment_.bindImage(CAUSTICA_IMAGE_MOMENT, GL_READ_WRITE);
   tileList_.bindImage(CAUSTICA_IMAGE_TILES, GL_READ_ONLY);
   if (hasAlpha()) coverage_.bindImage(CAUSTICA_IMAGE_COVERAGE, GL_READ_WRITE);
   // K samples per pixel per dispatch (samplesPerDispatch(): within llvmpipe's loop cap). Sample
@@ -470,7 +467,6 @@ AccumulationState Renderer::saveAccumulation() const {
   st.accum = accum_.readRgba32f();
   st.comp = comp_.readRgba32f();
   st.half = half_.readRgba32f();
-  st.moment = moment_.readRgba32f();
   if (transparent_) st.coverage = coverage_.readR32f();
   return st;
 }
@@ -480,8 +476,7 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
   if (state.width != settings_.width || state.height != settings_.height)
     throw Error("the saved accumulation is " + std::to_string(state.width) + "x" + std::to_string(state.height) +
                 " but the renderer is " + std::to_string(settings_.width) + "x" + std::to_string(settings_.height));
-  if (state.accum.size() != n || state.comp.size() != n || state.half.size() != n || state.moment.size() != n ||
-      state.spp < 0)
+  if (state.accum.size() != n || state.comp.size() != n || state.half.size() != n || state.spp < 0)
     throw Error("the saved accumulation is incomplete");
   if (transparent_ && state.coverage.size() != n / 4)
     throw Error("the saved accumulation has no coverage (alpha): it was not rendered with --background transparent");
@@ -489,7 +484,6 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
   accum_.uploadRgba32f(state.accum);
   comp_.uploadRgba32f(state.comp);
   half_.uploadRgba32f(state.half);
-  moment_.uploadRgba32f(state.moment);
   if (transparent_) coverage_.uploadR32f(state.coverage);
   spp_ = state.spp;
   sampleBase_ = state.sampleBase;

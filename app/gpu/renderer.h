@@ -48,7 +48,6 @@ struct AccumulationState {
   std::vector<float> accum;     // rgba32f running sums (rgb radiance, a = sample count), width*height*4
   std::vector<float> comp;      // rgba32f Kahan compensation terms of those sums, width*height*4
   std::vector<float> half;      // rgba32f sums of each pixel's odd-numbered samples (rgb) and their count (a)
-  std::vector<float> moment;    // rgba32f per channel sum of squared deviations from the running mean (M2), a = 0
   std::vector<float> coverage;  // r32f samples whose camera ray hit the scene, width*height; empty unless
                                 // the background is transparent
 };
@@ -152,7 +151,7 @@ class Renderer {
   std::unique_ptr<RasterRenderer> raster_;  // built the first time the raster mode is used
   EnvironmentTextures environment_;  // environment map, CDFs and UBO
   GlBuffer punctualUbo_;  // PunctualParams (KHR_lights_punctual), uploaded once per scene
-  GlTexture accum_, comp_, half_, moment_, tileList_, display_;
+  GlTexture accum_, comp_, half_, tileList_, display_;
   bool transparent_ = false;  // the scene's background is transparent: coverage_ exists
   GlTexture coverage_;        // r32f camera-ray hits per pixel (CAUSTICA_IMAGE_COVERAGE), if transparent_
   std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_

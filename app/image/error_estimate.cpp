@@ -15,32 +15,13 @@ double pixelChannelVariance(double sumA, double nA, double sumB, double nB) {
   return d * d / (1.0 / nA + 1.0 / nB) / n;
 }
 
-double pixelChannelMomentVariance(double m2, double n) {
-  if (!(n >= 2.0)) return std::numeric_limits<double>::infinity();
-  return m2 / (n - 1.0) / n;
-}
-
-std::vector<float> momentsFromHalves(const std::vector<float>& accum, const std::vector<float>& comp,
-                                     const std::vector<float>& half) {
-  std::vector<float> m2(accum.size(), 0.0f);
-  for (size_t i = 0; i + 3 < accum.size() && i + 3 < comp.size() && i + 3 < half.size(); i += 4) {
-    const double n = double(accum[i + 3]) - double(comp[i + 3]), nB = half[i + 3], nA = n - nB;
-    if (!(nA > 0.0 && nB > 0.0)) continue;
-    for (int ch = 0; ch < 3; ++ch) {
-      const double total = double(accum[i + ch]) - double(comp[i + ch]);
-      m2[i + ch] = static_cast<float>(n * (n - 1.0) * pixelChannelVariance(total - half[i + ch], nA, half[i + ch], nB));
-    }
-  }
-  return m2;
-}
-
 double pixelChannelRelMse(double sumA, double nA, double sumB, double nB) {
   const double m = (sumA + sumB) / (nA + nB);
   return pixelChannelVariance(sumA, nA, sumB, nB) / (m * m + kErrorEpsilon);
 }
 
 ErrorEstimate estimateError(int width, int height, const std::vector<float>& accum, const std::vector<float>& comp,
-                            const std::vector<float>& half, int tileSize, const std::vector<float>& moment) {
+                            const std::vector<float>& half, int tileSize) {
   ErrorEstimate e;
   e.width = width;
   e.height = height;
@@ -53,8 +34,6 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   e.tileSppMin.assign(e.tile.size(), std::numeric_limits<int>::max());
   std::vector<int> tilePixels(e.tile.size(), 0);
   if (pixels == 0 || accum.size() < pixels * 4 || comp.size() < pixels * 4 || half.size() < pixels * 4) return e;
-  const bool moments = moment.size() >= pixels * 4;
-  if (moments) e.tileMoment.assign(e.tile.size(), 0.0);
   // Pixel means first. The denominator is the median of three estimates of the pixel's true mean:
   // its own mean m (correlated with (mA - mB)^2: a bright outlier raises both, and alone it
   // underestimates skewed pixels, 0.58x at 8 spp on the Cornell box at 24x24), the mean of its 8
@@ -62,7 +41,7 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   // overestimated 1.7-7.7x, a dark pixel beside the light underestimated ~0.75x) and the lower of its
   // two half means (an outlier sits in one half only; biased low by the halves' noise). Each is wrong
   // in a different case, and in each case the other two agree (docs/adaptive-sampling.md).
-  std::vector<double> mean(pixels * 3), var(pixels * 3), lowHalf(pixels * 3), momentVar(moments ? pixels * 3 : 0);
+  std::vector<double> mean(pixels * 3), var(pixels * 3), lowHalf(pixels * 3);
   std::vector<int> count(pixels);
   for (size_t i = 0; i < pixels; ++i) {
     const float* a = &accum[i * 4];
@@ -76,7 +55,6 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
       mean[i * 3 + ch] = n > 0.0 ? total / n : 0.0;
       lowHalf[i * 3 + ch] = nA > 0.0 && nB > 0.0 ? std::min((total - b[ch]) / nA, double(b[ch]) / nB) : 0.0;
       var[i * 3 + ch] = pixelChannelVariance(total - b[ch], nA, b[ch], nB);
-      if (moments) momentVar[i * 3 + ch] = pixelChannelMomentVariance(moment[i * 4 + ch], n);
     }
   }
   double sum = 0.0, sppSum = 0.0;
@@ -84,7 +62,7 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
-      double rel = 0.0, relMoment = 0.0;
+      double rel = 0.0;
       for (int ch = 0; ch < 3; ++ch) {
         double m = 0.0;
         int k = 0;
@@ -99,10 +77,8 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
         const double own = mean[i * 3 + ch], low = lowHalf[i * 3 + ch];
         m = std::max(std::min(own, m), std::min(std::max(own, m), low));
         rel += var[i * 3 + ch] / (m * m + kErrorEpsilon);
-        if (moments) relMoment += momentVar[i * 3 + ch] / (m * m + kErrorEpsilon);
       }
       rel /= 3.0;
-      if (moments) e.tileMoment[static_cast<size_t>(y / tileSize) * e.tilesX + x / tileSize] += relMoment / 3.0;
       e.pixel[i] = static_cast<float>(rel);
       sum += rel;
       const int spp = count[i];
@@ -115,21 +91,18 @@ ErrorEstimate estimateError(int width, int height, const std::vector<float>& acc
       e.tileSppMin[t] = std::min(e.tileSppMin[t], spp);
     }
   for (size_t t = 0; t < e.tile.size(); ++t) e.tile[t] /= std::max(tilePixels[t], 1);
-  for (size_t t = 0; t < e.tileMoment.size(); ++t) e.tileMoment[t] /= std::max(tilePixels[t], 1);
   e.image = sum / static_cast<double>(pixels);
   e.sppMean = sppSum / static_cast<double>(pixels);
   return e;
 }
 
 std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int maxSppRatio, int dilation,
-                                     double smoothing, TileVariance variance, double targetMeanSpp) {
+                                     double smoothing) {
   const size_t tiles = e.tile.size();
-  const std::vector<double>& tileRel =
-      variance == TileVariance::Moments && e.tileMoment.size() == tiles ? e.tileMoment : e.tile;
   // Each tile's per-sample variance v = e n, blended with the mean over its 3x3 neighbourhood (finite
   // values only; non-finite ones stay as they are and keep the tile live).
-  std::vector<double> perSample(tiles), gain(tiles), smoothed(tiles);
-  for (size_t t = 0; t < tiles; ++t) perSample[t] = tileRel[t] * std::max(e.tileSppMin[t], 1);
+  std::vector<double> perSample(tiles), gain(tiles);
+  for (size_t t = 0; t < tiles; ++t) perSample[t] = e.tile[t] * std::max(e.tileSppMin[t], 1);
   double meanGain = 0.0;
   int mostSpp = 0, finite = 0;
   for (size_t t = 0; t < tiles; ++t) {
@@ -149,8 +122,7 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
       v = (1.0 - smoothing) * v + smoothing * sum / k;  // k >= 1: the tile itself is finite
     }
     const double n = std::max(e.tileSppMin[t], 1);
-    smoothed[t] = v;
-    gain[t] = smoothing > 0.0 ? v / (n * n) : tileRel[t] / n;  // e / n exactly without smoothing
+    gain[t] = smoothing > 0.0 ? v / (n * n) : e.tile[t] / n;  // e / n exactly without smoothing
     if (std::isfinite(gain[t])) {
       meanGain += gain[t];
       ++finite;
@@ -160,21 +132,6 @@ std::vector<std::uint32_t> liveTiles(const ErrorEstimate& e, int minSpp, int max
   // Slightly below the mean, so that tiles of equal gain all count as "at the mean" despite rounding.
   meanGain = meanGain / std::max(finite, 1) * (1.0 - 1e-9);
   std::vector<char> live(tiles, 0);
-  if (targetMeanSpp > 0.0) {
-    // Target rule: the guarded allocation for the finite tiles' smoothed variances at targetMeanSpp.
-    std::vector<double> v;
-    for (size_t t = 0; t < tiles; ++t)
-      if (std::isfinite(smoothed[t])) v.push_back(std::max(smoothed[t], 0.0));
-    const std::vector<double> goal = guardedAllocation(v, targetMeanSpp, minSpp, maxSppRatio, 60);
-    size_t k = 0, count = 0;
-    for (size_t t = 0; t < tiles; ++t) {
-      const bool behind = e.tileSppMin[t] < minSpp || static_cast<double>(e.tileSppMin[t]) * maxSppRatio < mostSpp;
-      const bool below = std::isfinite(smoothed[t]) ? e.tileSppMin[t] < goal[k++] : true;
-      live[t] = behind || below;
-      count += live[t];
-    }
-    if (count == 0) live.assign(tiles, 1);
-  } else
   for (int ty = 0; ty < e.tilesY; ++ty)
     for (int tx = 0; tx < e.tilesX; ++tx) {
       const size_t t = static_cast<size_t>(ty) * e.tilesX + tx;
@@ -205,70 +162,44 @@ double adaptiveGainBound(const std::vector<double>& v) {
   return (sumV / n) / ((sumSigma / n) * (sumSigma / n));
 }
 
-std::vector<double> guardedAllocation(const std::vector<double>& v, double meanSpp, int minSpp, int maxSppRatio,
-                                      int steps) {
-  std::vector<double> uniform(v.size(), meanSpp);
-  for (double x : v)
-    if (!std::isfinite(x) || x < 0.0) return uniform;
-  if (v.empty() || meanSpp <= minSpp) return uniform;
-  const double count = static_cast<double>(v.size());
-  std::vector<double> sigma(v.size());
-  for (size_t i = 0; i < v.size(); ++i) sigma[i] = std::sqrt(v[i]);
-  // Under floor `lo` and cap `hi` the best allocation is n = clamp(c sigma, lo, hi) (Lagrange, with the
-  // box constraints active where they bind), c such that mean(n) = meanSpp; its mean relMSE:
-  auto allocationFor = [&](double lo, double hi, std::vector<double>& n) {
-    auto meanOf = [&](double c) {
-      double s = 0.0;
-      for (double x : sigma) s += std::clamp(c * x, lo, hi);
-      return s / count;
-    };
-    double a = 0.0, b = 1.0;
-    while (meanOf(b) < meanSpp && b < 1e300) b *= 2.0;
-    for (int i = 0; i < 100 && b - a > 1e-12 * b; ++i) {
-      const double mid = 0.5 * (a + b);
-      (meanOf(mid) < meanSpp ? a : b) = mid;
-    }
-    double e = 0.0;
-    for (size_t i = 0; i < v.size(); ++i) {
-      n[i] = std::clamp(b * sigma[i], lo, hi);
-      e += v[i] / n[i];
-    }
-    return e / count;
-  };
-  std::vector<double> best = uniform, n(v.size());
-  double bestError = std::numeric_limits<double>::infinity();
-  auto consider = [&](double lo, double hi) {
-    const double e = allocationFor(lo, hi, n);
-    if (e < bestError) {
-      bestError = e;
-      best = n;
-    }
-  };
-  if (maxSppRatio <= 0) {
-    consider(minSpp, std::numeric_limits<double>::infinity());
-  } else {
-    // No tile more than maxSppRatio behind the most sampled: n in [hi / ratio, hi] with the floor at
-    // least minSpp and hi / ratio <= meanSpp <= hi. Scan the cap hi (log-spaced) for the least error.
-    for (int k = 0; k <= steps; ++k) {
-      const double hi = meanSpp * std::pow(static_cast<double>(maxSppRatio), double(k) / steps);
-      const double lo = std::max(static_cast<double>(minSpp), hi / maxSppRatio);
-      if (lo <= meanSpp) consider(lo, hi);
-    }
-  }
-  return best;
-}
-
 double guardedAdaptiveGainBound(const std::vector<double>& v, double meanSpp, int minSpp, int maxSppRatio) {
   const double bound = adaptiveGainBound(v);
   if (!std::isfinite(bound)) return bound;
   if (meanSpp <= minSpp) return 1.0;
-  const std::vector<double> n = guardedAllocation(v, meanSpp, minSpp, maxSppRatio);
-  double sumV = 0.0, e = 0.0;
-  for (size_t i = 0; i < v.size(); ++i) {
-    sumV += v[i];
-    e += v[i] / n[i];
+  const double count = static_cast<double>(v.size());
+  double sumV = 0.0;
+  for (double x : v) sumV += x;
+  // Under floor `lo` and cap `hi` the best allocation is n = clamp(c sigma, lo, hi) (Lagrange, with the
+  // box constraints active where they bind), c such that mean(n) = meanSpp; its mean relMSE:
+  auto relMseFor = [&](double lo, double hi) {
+    auto meanOf = [&](double c) {
+      double s = 0.0;
+      for (double x : v) s += std::clamp(c * std::sqrt(x), lo, hi);
+      return s / count;
+    };
+    double a = 0.0, b = 1.0;
+    while (meanOf(b) < meanSpp && b < 1e300) b *= 2.0;
+    for (int i = 0; i < 100; ++i) {
+      const double mid = 0.5 * (a + b);
+      (meanOf(mid) < meanSpp ? a : b) = mid;
+    }
+    double e = 0.0;
+    for (double x : v) e += x / std::clamp(b * std::sqrt(x), lo, hi);
+    return e / count;
+  };
+  double best = std::numeric_limits<double>::infinity();
+  if (maxSppRatio <= 0) {
+    best = relMseFor(minSpp, std::numeric_limits<double>::infinity());
+  } else {
+    // No tile more than maxSppRatio behind the most sampled: n in [hi / ratio, hi] with the floor at
+    // least minSpp and hi / ratio <= meanSpp <= hi. Scan the cap hi (log-spaced) for the least error.
+    for (int k = 0; k <= 400; ++k) {
+      const double hi = meanSpp * std::pow(static_cast<double>(maxSppRatio), k / 400.0);
+      const double lo = std::max(static_cast<double>(minSpp), hi / maxSppRatio);
+      if (lo <= meanSpp) best = std::min(best, relMseFor(lo, hi));
+    }
   }
-  return (sumV / meanSpp) / e;
+  return (sumV / count / meanSpp) / best;
 }
 
 }  // namespace caustica

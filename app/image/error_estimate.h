@@ -22,10 +22,6 @@ struct ErrorEstimate {
   int tileSize = 8, tilesX = 0, tilesY = 0;  // tiles of tileSize x tileSize pixels (edge tiles smaller)
   std::vector<float> pixel;       // relMSE estimate per pixel; +inf where a half has no sample
   std::vector<double> tile;       // mean of `pixel` over each tile (row-major, tilesX x tilesY)
-  // The same relMSE per tile with each pixel channel's variance from its sample variance (the moment
-  // image: n - 1 degrees of freedom instead of the halves' one), same denominator; empty without the
-  // moment image, +inf where a pixel has fewer than 2 samples. Adaptive sampling's allocation.
-  std::vector<double> tileMoment;
   std::vector<int> tileSppMin;    // fewest samples of any pixel of the tile
   double image = std::numeric_limits<double>::infinity();  // mean of `pixel` over the image
   int sppMin = 0, sppMax = 0;     // samples per pixel (finite samples; non-finite ones are not counted)
@@ -34,24 +30,8 @@ struct ErrorEstimate {
 
 // From the three rgba32f images of Renderer (width*height*4 floats each): accum (running sums,
 // a = count), comp (their Kahan compensation) and half (odd-numbered samples' sum and count).
-// `moment` (optional, the same size): per channel sum of squared deviations from the running mean
-// (Welford's M2, accumulate.glsl); fills ErrorEstimate::tileMoment.
 ErrorEstimate estimateError(int width, int height, const std::vector<float>& accum, const std::vector<float>& comp,
-                            const std::vector<float>& half, int tileSize = 8, const std::vector<float>& moment = {});
-
-// The variance of one pixel channel's mean from its samples' sum of squared deviations m2 over n
-// samples: m2 / (n - 1) / n, unbiased (+inf when n < 2).
-double pixelChannelMomentVariance(double m2, double n);
-
-// A moment image for accumulations that have none (checkpoints before version 4): per pixel channel
-// M2 = n (n - 1) Var(m) with Var(m) from the halves (pixelChannelVariance), an unbiased estimate of the
-// sum of squared deviations; 0 where a half is empty. Same layout as `accum` (a = 0).
-std::vector<float> momentsFromHalves(const std::vector<float>& accum, const std::vector<float>& comp,
-                                     const std::vector<float>& half);
-
-// Which per-tile variance liveTiles allocates by: the halves' (ErrorEstimate::tile) or the moments'
-// (ErrorEstimate::tileMoment; the halves' where it is empty).
-enum class TileVariance { Halves, Moments };
+                            const std::vector<float>& half, int tileSize = 8);
 
 // The variance estimate of one pixel channel's mean from its two halves: sums sumA, sumB of nA, nB
 // samples (+inf when a half is empty), and its relMSE with the pixel's own mean in the denominator.
@@ -71,24 +51,8 @@ double pixelChannelRelMse(double sumA, double nA, double sumB, double nB);
 // mean over its 3x3 tile neighbourhood, (1 - smoothing) own + smoothing neighbourhood: a 4x4 tile's
 // own estimate swings with single bright samples and misses rare paths its neighbours share
 // (docs/adaptive-sampling.md, docs/benchmarks.md "Adaptive sampling": 0.5 allocates better).
-// `variance`: which per-tile estimate (above).
-// `targetMeanSpp` > 0 selects the *target rule* instead of the gain rule: the tiles live are those with
-// fewer samples than the guarded allocation with the least mean relMSE for their (smoothed) per-sample
-// variances at a mean of `targetMeanSpp` samples (guardedAllocation below; the sampler passes the mean
-// it expects at its next check). The gain rule follows the noise of the estimates between tiles of
-// equal variance; the target's floor (>= 1/maxSppRatio of its cap) flattens it and its cap lets the
-// noisiest tiles reach maxSppRatio x the floor (docs/benchmarks.md, "Adaptive sampling", session 6).
-// `dilation` is not used by the target rule; the minSpp and ratio guards and NaN / +inf tiles are.
-// When no tile is below its target (rounding), every tile is live.
 std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, int minSpp, int maxSppRatio, int dilation,
-                                     double smoothing = 0.0, TileVariance variance = TileVariance::Halves,
-                                     double targetMeanSpp = 0.0);
-
-// The allocation guardedAdaptiveGainBound scores: n = clamp(c sqrt(v), lo, hi) with lo >= minSpp,
-// hi <= maxSppRatio lo, mean(n) = meanSpp, the cap hi scanned over `steps` log-spaced values for the
-// least mean(v / n). Every n = meanSpp when meanSpp <= minSpp or the v are not all finite and >= 0.
-std::vector<double> guardedAllocation(const std::vector<double>& tileVariance, double meanSpp, int minSpp,
-                                      int maxSppRatio, int steps = 400);
+                                     double smoothing = 0.0);
 
 // How much adaptive sampling can gain at all (docs/benchmarks.md, "Adaptive sampling"). `tileVariance`:
 // each tile's per-sample relative variance v (relMSE x samples per pixel under uniform sampling; tiles

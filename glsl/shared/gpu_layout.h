@@ -56,7 +56,6 @@ using uint = std::uint32_t;
 #define CAUSTICA_IMAGE_HALF 3         // image unit: rgba32f sum (rgb) and count (a) of each pixel's odd-numbered samples (error estimate)
 #define CAUSTICA_IMAGE_TILES 4        // image unit: r32ui list of live tiles (adaptive sampling), x | y << 16 in tiles
 #define CAUSTICA_IMAGE_COVERAGE 5     // image unit: r32f samples whose camera ray hit the scene (--background transparent)
-#define CAUSTICA_IMAGE_MOMENT 6       // image unit: rgba32f per channel sum of squared deviations of a pixel's samples (Welford's M2; adaptive sampling)
 #define CAUSTICA_TILE_LIST_WIDTH 1024 // texels per row of the live-tile list image
 #define CAUSTICA_WORKGROUP_X 8        // compute work-group size in pixels
 #define CAUSTICA_WORKGROUP_Y 8

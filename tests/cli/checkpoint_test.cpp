@@ -7,9 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "cli/bench/bench_metrics.h"
 #include "cli/checkpoint.h"
-#include "image/error_estimate.h"
 #include "util/error.h"
 
 using namespace caustica;
@@ -28,7 +26,6 @@ Checkpoint sample(int w, int h, float base) {
     ck.state.accum.push_back(base + 0.25f * float(i));
     ck.state.comp.push_back(-1e-7f * float(i));
     ck.state.half.push_back(0.5f * base + 0.125f * float(i));
-    ck.state.moment.push_back(i % 4 == 3 ? 0.0f : 0.0625f * float(i));
   }
   ck.seed = 7;
   ck.sceneHash = 0x0123456789abcdefull;
@@ -55,20 +52,6 @@ void spit(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 }
 
-// A version-4 file of `st` (opaque) rewritten as version 3 wrote it: no moment image after the half
-// image, and the data checksum over the three others.
-std::string asVersion3(std::string v4, const AccumulationState& st) {
-  v4.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 3");
-  const size_t n = st.accum.size() * sizeof(float), dataAt = v4.find("\nend\n") + 5;
-  v4.erase(dataAt + 3 * n, n);
-  std::uint64_t h = fnv1a64(st.accum.data(), n);
-  h = fnv1a64(st.comp.data(), n, h);
-  h = fnv1a64(st.half.data(), n, h);
-  const size_t at = v4.find("\ndata ") + 6;
-  v4.replace(at, v4.find('\n', at) - at, hex64(h));
-  return v4;
-}
-
 }  // namespace
 
 TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
@@ -87,9 +70,8 @@ TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
   CHECK(b.state.accum == a.state.accum);
   CHECK(b.state.comp == a.state.comp);
   CHECK(b.state.half == a.state.half);
-  CHECK(b.state.moment == a.state.moment);
   CHECK(b.state.coverage.empty());  // an opaque render has no coverage image
-  CHECK(slurp(path).rfind("CAUSTICA-CKPT 4\n", 0) == 0);
+  CHECK(slurp(path).rfind("CAUSTICA-CKPT 3\n", 0) == 0);
   CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.settingsText).empty());
 }
 
@@ -113,40 +95,12 @@ TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; v
   // A version-2 file (written before coverage existed: no coverage line, three images) loads as opaque.
   writeCheckpoint(path, sample(3, 2, 1.5f));
   std::string v2 = slurp(path);
-  v2 = asVersion3(v2, a.state);
   v2.replace(0, std::string("CAUSTICA-CKPT 3").size(), "CAUSTICA-CKPT 2");
   v2.erase(v2.find("coverage 0\n"), std::string("coverage 0\n").size());
   spit(path, v2);
   Checkpoint old = readCheckpoint(path);
   CHECK(old.state.coverage.empty());
   CHECK(old.state.half == a.state.half);
-  CHECK(old.state.moment == momentsFromHalves(a.state.accum, a.state.comp, a.state.half));
-}
-
-TEST_CASE("checkpoint: version 4 stores the moment image; version 3 files load with moments from their halves") {
-  std::string path = tempPath("moment.ckpt");
-  Checkpoint a = sample(3, 2, 1.5f);
-  writeCheckpoint(path, a);
-  const std::string v4 = slurp(path);
-  // The moments are checksummed: a flipped bit in them (the fourth image) is refused.
-  std::string flipped = v4;
-  flipped[v4.find("\nend\n") + 5 + 3 * a.state.accum.size() * sizeof(float) + 5] ^= 0x10;
-  spit(path, flipped);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
-  // Without the moment block the file reads as truncated.
-  spit(path, v4.substr(0, v4.size() - a.state.accum.size() * sizeof(float)));
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("truncated"), Error);
-  // Version 3 (no moments): loads, its moments estimated from the halves, every other image as written.
-  spit(path, asVersion3(v4, a.state));
-  Checkpoint old = readCheckpoint(path);
-  CHECK(old.state.accum == a.state.accum);
-  CHECK(old.state.half == a.state.half);
-  const std::vector<float> expected = momentsFromHalves(a.state.accum, a.state.comp, a.state.half);
-  CHECK(old.state.moment == expected);
-  CHECK(expected[0] > 0.0f);  // (the sample's halves differ: a non-zero estimate)
-  // Rewritten, it becomes a version-4 file with those moments.
-  writeCheckpoint(path, old);
-  CHECK(readCheckpoint(path).state.moment == expected);
 }
 
 TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with the file's name") {
@@ -163,9 +117,9 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
   // A version-1 file (no half image: no error estimate to resume adaptive sampling from) is refused.
   std::string v1 = good;
-  v1.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 1");
+  v1.replace(0, std::string("CAUSTICA-CKPT 3").size(), "CAUSTICA-CKPT 1");
   spit(path, v1);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 2 to 4)"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 2 to 3)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);

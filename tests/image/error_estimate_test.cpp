@@ -1,5 +1,5 @@
-// error_estimate_test.cpp — the half-image and moment-image relMSE estimators on synthetic samples of
-// known variance, and the live tiles of adaptive sampling (minimum spp, threshold, dilation).
+// error_estimate_test.cpp — the half-image relMSE estimator on synthetic samples of known variance,
+// and the live tiles of adaptive sampling (minimum spp, threshold, dilation).
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -12,10 +12,9 @@ using namespace caustica;
 namespace {
 
 // Images of w x h pixels whose samples are normal(mean, sd), `spp` of them per pixel, split as the
-// shader splits them (odd-numbered samples to the half image), with the moment image updated as
-// accumulate.glsl does (Welford, in float); comp stays zero.
+// shader splits them (odd-numbered samples to the half image); comp stays zero.
 struct Synthetic {
-  std::vector<float> accum, comp, half, moment;
+  std::vector<float> accum, comp, half;
 };
 Synthetic synthetic(int w, int h, int spp, double mean, double sd, unsigned seed) {
   std::mt19937 gen(seed);
@@ -24,16 +23,10 @@ Synthetic synthetic(int w, int h, int spp, double mean, double sd, unsigned seed
   s.accum.assign(static_cast<size_t>(w) * h * 4, 0.0f);
   s.comp = s.accum;
   s.half = s.accum;
-  s.moment = s.accum;
   for (size_t p = 0; p < static_cast<size_t>(w) * h; ++p)
     for (int k = 0; k < spp; ++k) {
       for (int c = 0; c < 3; ++c) {
         float x = static_cast<float>(dist(gen));
-        const float before = s.accum[p * 4 + 3];
-        if (before > 0.0f) {
-          const float d = x - s.accum[p * 4 + c] / before;
-          s.moment[p * 4 + c] += d * d * (before / (before + 1.0f));
-        }
         s.accum[p * 4 + c] += x;
         if (k % 2 == 1) s.half[p * 4 + c] += x;
       }
@@ -76,66 +69,6 @@ TEST_CASE("error estimate: the variance of the mean is unbiased; the relMSE near
     MESSAGE(spp << " spp: estimate / expected " << e.image / expected);
     CHECK(std::abs(e.image / expected - 1.0) < 0.08);
   }
-}
-
-TEST_CASE("error estimate: the moment image's variance is unbiased and far less noisy than the halves'") {
-  // Per tile of 4x4 pixels: the halves give one degree of freedom per pixel channel, the moments
-  // n - 1. Over 256 tiles of a 64x64 image at 64 spp, the mean of the moment estimate is within
-  // 1 % of sd^2 / n (its relative sd: sqrt(2 / (4096 * 3 * 63)) = 0.16 %), and its spread over the
-  // tiles is ~sqrt(63) times smaller than the halves' (measured: 0.027 against 0.199). Seen failing
-  // with the variance divided by n^2 instead of n (n - 1): 0.985.
-  const int spp = 64;
-  const double mean = 0.5, sd = 0.1;
-  Synthetic s = synthetic(64, 64, spp, mean, sd, 41u);
-  double var = 0.0;
-  for (size_t p = 0; p < 64 * 64; ++p)
-    for (int c = 0; c < 3; ++c) var += pixelChannelMomentVariance(s.moment[p * 4 + c], spp) / (64.0 * 64.0 * 3.0);
-  MESSAGE("moment variance / expected " << var / (sd * sd / spp));
-  CHECK(std::abs(var / (sd * sd / spp) - 1.0) < 0.01);
-  const ErrorEstimate e = estimateError(64, 64, s.accum, s.comp, s.half, 4, s.moment);
-  REQUIRE(e.tileMoment.size() == e.tile.size());
-  auto spread = [](const std::vector<double>& t) {
-    double m = 0.0, q = 0.0;
-    for (double x : t) m += x / double(t.size());
-    for (double x : t) q += (x - m) * (x - m) / double(t.size());
-    return std::sqrt(q) / m;
-  };
-  const double expected = sd * sd / spp / (mean * mean + kErrorEpsilon);
-  double meanMoment = 0.0;
-  for (double x : e.tileMoment) meanMoment += x / double(e.tileMoment.size());
-  MESSAGE("tile relMSE from moments / expected " << meanMoment / expected << "; relative spread over tiles: halves "
-                                                  << spread(e.tile) << ", moments " << spread(e.tileMoment));
-  CHECK(std::abs(meanMoment / expected - 1.0) < 0.02);
-  CHECK(spread(e.tileMoment) < spread(e.tile) / 4.0);
-  // Without a moment image: no moment estimate.
-  CHECK(estimateError(64, 64, s.accum, s.comp, s.half, 4).tileMoment.empty());
-  // Exact values: samples 1 and 3 give M2 = (3 - 1) * (3 - 2) = 2, var(mean) = 2 / 1 / 2 = 1 (as the halves).
-  CHECK(pixelChannelMomentVariance(2.0, 2.0) == 1.0);
-  CHECK(std::isinf(pixelChannelMomentVariance(0.0, 1.0)));
-}
-
-TEST_CASE("error estimate: moments estimated from the halves (checkpoints before version 4)") {
-  // One pixel, samples 1 (even) and 3 (odd) in every channel: M2 = n (n - 1) var(mean) = 2 * 1 * 1 = 2.
-  std::vector<float> accum = {4.0f, 4.0f, 4.0f, 2.0f}, comp(4, 0.0f), half = {3.0f, 3.0f, 3.0f, 1.0f};
-  std::vector<float> m2 = momentsFromHalves(accum, comp, half);
-  REQUIRE(m2.size() == 4);
-  CHECK(m2[0] == 2.0f);
-  CHECK(m2[2] == 2.0f);
-  CHECK(m2[3] == 0.0f);
-  // On synthetic samples: unbiased, so the moment-based tile estimate from them matches the halves' mean.
-  Synthetic s = synthetic(64, 64, 32, 0.5, 0.1, 43u);
-  const std::vector<float> fromHalves = momentsFromHalves(s.accum, s.comp, s.half);
-  double a = 0.0, b = 0.0;
-  for (size_t i = 0; i < fromHalves.size(); ++i)
-    if (i % 4 != 3) {
-      a += fromHalves[i];
-      b += s.moment[i];
-    }
-  MESSAGE("sum of M2 from the halves / from the samples " << a / b);
-  CHECK(std::abs(a / b - 1.0) < 0.05);  // 12288 chi-square(1) estimates: relative sd 1.3 %
-  // An empty half: 0.
-  half = {0.0f, 0.0f, 0.0f, 0.0f};
-  CHECK(momentsFromHalves(accum, comp, half)[0] == 0.0f);
 }
 
 TEST_CASE("error estimate: a pixel with an empty half is unknown (infinite), never converged") {
@@ -237,21 +170,4 @@ TEST_CASE("live tiles: smoothing blends each tile's per-sample variance with its
   e.tile[0] = 1.0;
   live = liveTiles(e, 16, 8, 0, 0.5);
   CHECK(live == std::vector<std::uint32_t>{0u, 1u, 1u << 16, 1u | (1u << 16), 2u | (2u << 16)});
-}
-
-TEST_CASE("live tiles: TileVariance::Moments allocates by the moment estimate, the halves' where it is absent") {
-  ErrorEstimate e;
-  e.tileSize = 4;
-  e.tilesX = 5;
-  e.tilesY = 1;
-  e.tile.assign(5, 0.001);
-  e.tileSppMin.assign(5, 32);
-  e.tile[1] = 1.0;           // the halves say tile 1 is noisy
-  CHECK(liveTiles(e, 16, 8, 0, 0.0, TileVariance::Moments) == std::vector<std::uint32_t>{1u});  // no moments: halves
-  e.tileMoment.assign(5, 0.001);
-  e.tileMoment[3] = 1.0;     // the moments say tile 3
-  CHECK(liveTiles(e, 16, 8, 0, 0.0, TileVariance::Halves) == std::vector<std::uint32_t>{1u});
-  CHECK(liveTiles(e, 16, 8, 0, 0.0, TileVariance::Moments) == std::vector<std::uint32_t>{3u});
-  // Smoothed (0.5): tile 3 21.3, tile 4 (two neighbours) 8.02, tile 2 (three) 5.36, mean 6.95.
-  CHECK(liveTiles(e, 16, 8, 0, 0.5, TileVariance::Moments) == std::vector<std::uint32_t>{3u, 4u});
 }

@@ -198,25 +198,6 @@ class BenchRunner {
     const AccumulationState st = renderer.saveAccumulation();
     auto tiles = [&](int tile) { return tileRelVariance(st.accum, st.comp, st.half, ref.image, tile); };
     const std::vector<double> v4 = tiles(4);
-    {  // per pixel (row-major): the uniform render's per-sample relative variance (reference-weighted) from
-       // the halves and from the moments, for offline analyses of per-tile estimators (docs/benchmarks.md)
-      std::ofstream f(outDir_ + "/" + name + "-" + dispersionModeName(mode) + "-pixel-variance.txt");
-      f << "# " << ref.image.width << "x" << ref.image.height << " pixels, row-major: per-sample relative variance "
-        << "from the halves, from the moments (uniform render, " << spp << " spp)\n";
-      for (int y = 0; y < ref.image.height; ++y)
-        for (int x = 0; x < ref.image.width; ++x) {
-          const size_t i = static_cast<size_t>(y) * ref.image.width + x;
-          const double n = double(st.accum[i * 4 + 3]) - double(st.comp[i * 4 + 3]), nB = st.half[i * 4 + 3];
-          double vh = 0.0, vm = 0.0;
-          for (int c = 0; c < 3; ++c) {
-            const double total = double(st.accum[i * 4 + c]) - double(st.comp[i * 4 + c]), r = ref.image.at(x, y, c);
-            const double w = n / (r * r + kRelMseEpsilon) / 3.0;
-            vh += pixelChannelVariance(total - st.half[i * 4 + c], n - nB, st.half[i * 4 + c], nB) * w;
-            vm += pixelChannelMomentVariance(st.moment[i * 4 + c], n) * w;
-          }
-          f << formatDouble("%.6g", vh) << ' ' << formatDouble("%.6g", vm) << '\n';
-        }
-    }
     double meanV = 0.0;
     for (double x : v4) meanV += x / static_cast<double>(v4.size());
     const double spp01 = meanV / 0.01;
@@ -245,10 +226,10 @@ class BenchRunner {
       std::ofstream f(outDir_ + "/" + name + "-" + dispersionModeName(mode) + "-tile-variance.txt");
       f << "# per tile of " << sampler.tileSize() << "x" << sampler.tileSize() << " pixels, row-major, " << e.tilesX
         << " a row: per-sample relative variance (uniform render), the adaptive render's samples per pixel and its\n"
-        << "# own estimate of the per-sample variance (relMSE estimate x samples), from the halves and from the moments\n";
+        << "# own estimate of the per-sample variance (relMSE estimate x samples)\n";
       for (size_t t = 0; t < vt.size(); ++t)
         f << formatDouble("%.6g", vt[t]) << ' ' << e.tileSppMin[t] << ' ' << formatDouble("%.6g", e.tile[t] * e.tileSppMin[t])
-          << ' ' << formatDouble("%.6g", e.tileMoment.empty() ? 0.0 : e.tileMoment[t] * e.tileSppMin[t]) << '\n';
+          << '\n';
     }
     double expected = 0.0, meanVt = 0.0;
     for (size_t t = 0; t < vt.size(); ++t) {
