@@ -24,7 +24,9 @@
 // by entry distance (a 5-exchange network): the nearest is visited next, the others stacked (refs
 // only), nearest on top — the same order as the C++ twin's, so ties between equal t resolve the same
 // way. A popped subtree beyond the closest hit so far is not skipped on the stack: its node visit
-// enters none of its children (their boxes end before hit.t), so no distances are stacked.
+// enters none of its children (their boxes end before hit.t), so no distances are stacked. The stack's
+// top eight refs are kept in registers and the inner loop never indexes the local array (see
+// BVH_INNER_STEP; docs/benchmarks.md, "Session 6").
 
 struct Hit {
   float t;   // distance along dir (units of |dir|)
@@ -78,6 +80,22 @@ void bvhSortPair(inout float ta, inout uint ra, inout float tb, inout uint rb) {
   rb = s ? r0 : rb;
 }
 
+// min and max for operands that are never NaN, as selects: GLSL min/max compile on llvmpipe to
+// vminps/vmaxps plus a NaN test and a masked move (its NaN-safe min/max); `a < b ? a : b` is one
+// vminps. The slab distances below are never NaN: invDir is finite and nonzero (safeInverse, unit
+// directions), boxes are finite or +inf (empty slots), so (bound - org) * invDir is a number or +-inf.
+// Where a and b are zeros of both signs the result's sign may differ from min/max; the distances are
+// only compared, never used as values, so the traversal is the same.
+// `precise` keeps NIR from folding the select back into fmin/fmax (its rule is for inexact selects).
+vec4 bvhMin(vec4 a, vec4 b) {
+  precise vec4 m = mix(b, a, lessThan(a, b));
+  return m;
+}
+vec4 bvhMax(vec4 a, vec4 b) {
+  precise vec4 m = mix(b, a, greaterThan(a, b));
+  return m;
+}
+
 // Tests the four children of wide node `index` against the ray within tmax (intersectAabb on each
 // component). Returns how many it enters; ref/t = the children sorted by entry distance (units of
 // |dir|), entered ones first, missed ones after at kBvhMissT.
@@ -90,12 +108,12 @@ uint bvhVisitWide(uint index, vec3 org, vec3 invDir, float tmax, out uvec4 ref, 
   vec4 z0 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 4)) - org.z) * invDir.z;
   vec4 z1 = (uintBitsToFloat(texelFetch(bvhWideTexels, base + 5)) - org.z) * invDir.z;
   ref = texelFetch(bvhWideTexels, base + 6);
-  vec4 hx = max(x0, x1), hy = max(y0, y1), hz = max(z0, z1);
+  vec4 hx = bvhMax(x0, x1), hy = bvhMax(y0, y1), hz = bvhMax(z0, z1);
   hx = mix(hx, vec4(3.0e38), equal(hx, vec4(0.0)));
   hy = mix(hy, vec4(3.0e38), equal(hy, vec4(0.0)));
   hz = mix(hz, vec4(3.0e38), equal(hz, vec4(0.0)));
-  vec4 tnear = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), vec4(0.0)));
-  vec4 tfar = min(min(hx, hy), min(hz, vec4(tmax))) * kBvhBoxPad;
+  vec4 tnear = bvhMax(bvhMax(bvhMin(x0, x1), bvhMin(y0, y1)), bvhMax(bvhMin(z0, z1), vec4(0.0)));
+  vec4 tfar = bvhMin(bvhMin(hx, hy), bvhMin(hz, vec4(tmax))) * kBvhBoxPad;
   bvec4 entered = lessThanEqual(tnear, tfar);
   t = mix(vec4(kBvhMissT), tnear, entered);
   bvhSortPair(t.x, ref.x, t.y, ref.y);
@@ -129,6 +147,80 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   return traceInstanced(org, dir, tmax, CAUSTICA_INSTANCE_RECORD_BASE, true, hit, inst);
 }
 #else
+// The wide traversal's stack (traceClosest, traceOccluded) is split in two: the top eight refs live in
+// registers, a (a.x the topmost) then b, tn of them; the rest lie below them in the local array
+// stackRef[0..sp-1]. On llvmpipe an indexed write of a local array is, at each call site, a
+// read-modify-write of every lane with a branch on the lane's mask bit, and a read is a gather; the
+// inner node loop touches registers only. A push that would overflow the eight registers ends the
+// lane's inner loop as an empty leaf with the node kept in pendNode; the outer loop then moves the
+// bottom four registers to the array and the node is visited again. The array is read only when the
+// registers are empty, also in the outer loop. One stack (LIFO) all the same: the same order of visits
+// as the C++ twin's. Both are rare (bundled scenes: at most 0.001 overflows and 0.004 array pops per
+// ray, docs/benchmarks.md "Session 6"), but each array access site costs on every pass of its loop.
+
+// Pushes r.y, r.z, r.w (the first k, 0..3; r.y on top) onto the register stack (a, b).
+void bvhRegPush(inout uvec4 a, inout uvec4 b, uvec4 r, uint k) {
+  b = k == 3u ? uvec4(a.yzw, b.x) : (k == 2u ? uvec4(a.zw, b.xy) : (k == 1u ? uvec4(a.w, b.xyz) : b));
+  a = k == 3u ? uvec4(r.yzw, a.x) : (k == 2u ? uvec4(r.yz, a.xy) : (k == 1u ? uvec4(r.y, a.xyz) : a));
+}
+
+// Removes the top of the register stack (a.x).
+void bvhRegPop(inout uvec4 a, inout uvec4 b) {
+  a = uvec4(a.yzw, b.x);
+  b = b.yzww;
+}
+
+// One step of the inner node loop after bvhVisitWide (hits, r) of node ref: pushes entered children
+// 1..hits-1 (child 1 on top; packBvhWideNodes guarantees sp + tn + 3 <= the stack size, the check only
+// guards memory) and sets ref to child 0, else the top of the registers, else the empty leaf (the outer
+// loop pops the array). When the push does not fit the registers, the lane leaves the inner loop as the
+// empty leaf with pendNode = ref: the outer loop moves the bottom four registers to the array and the
+// node is visited again (same ray, same hit.t: the same children). Selects only, no branches.
+#define BVH_INNER_STEP \
+      uint k = (hits > 1u && sp + tn + 3u <= uint(CAUSTICA_BVH_WIDE_STACK)) ? hits - 1u : 0u; \
+      bool fits = tn + k <= 8u; \
+      uint kk = fits ? k : 0u; \
+      bool pop = hits == 0u && tn > 0u; \
+      uint next = hits > 0u ? r.x : (tn > 0u ? a.x : kBvhEmptyRef); \
+      uvec4 pa = uvec4(a.yzw, b.x); \
+      uvec4 pb = b.yzww; \
+      bvhRegPush(a, b, r, kk); \
+      a = pop ? pa : a; \
+      b = pop ? pb : b; \
+      tn = tn + kk - (pop ? 1u : 0u); \
+      pendNode = fits ? pendNode : ref; \
+      ref = fits ? next : kBvhEmptyRef;
+
+// The outer loop's step after a leaf: a pending node (tn >= 6: the bottom four registers go to the
+// array, deepest first, and the node is visited again), else a pop from the registers, else from the
+// array, else done.
+#define BVH_OUTER_STEP \
+    if (pendNode != kInvalidIndex) { \
+      stackRef[sp] = tn == 8u ? b.w : (tn == 7u ? b.z : b.y); \
+      stackRef[sp + 1u] = tn == 8u ? b.z : (tn == 7u ? b.y : b.x); \
+      stackRef[sp + 2u] = tn == 8u ? b.y : (tn == 7u ? b.x : a.w); \
+      stackRef[sp + 3u] = tn == 8u ? b.x : (tn == 7u ? a.w : a.z); \
+      sp += 4u; \
+      tn -= 4u; \
+      ref = pendNode; \
+      pendNode = kInvalidIndex; \
+    } else if (tn > 0u) { \
+      ref = a.x; \
+      bvhRegPop(a, b); \
+      --tn; \
+    } else if (sp > 0u) { \
+      ref = stackRef[--sp]; \
+    } else { \
+      break; \
+    }
+
+#define BVH_STACK_VARS \
+  uint stackRef[CAUSTICA_BVH_WIDE_STACK]; \
+  uint sp = 0u; \
+  uvec4 a = uvec4(0u), b = uvec4(0u); \
+  uint tn = 0u; \
+  uint pendNode = kInvalidIndex;
+
 // Closest hit with 0 < t < tmax. On a miss returns false with hit.t = tmax and hit.tri = kInvalidIndex.
 bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   hit.t = tmax;
@@ -140,33 +232,16 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
 
   // Refs only, as in traceOccluded: a popped subtree is entered even when its entry distance is beyond
   // the closest hit (bvhVisitWide then enters none of its children, or its leaf's triangles fail the
-  // t < hit.t test), so the hit is the same. On llvmpipe every indexed write of a local array is a
-  // loop over the 8 lanes at each call site, and a pop that skips far subtrees is a loop: one word per
-  // push instead of two and one gather per pop: 0.97-1.09x the render speed, median 1.02x, on the
-  // bundled scenes (docs/benchmarks.md, Session 5, part 4).
-  uint stackRef[CAUSTICA_BVH_WIDE_STACK];
-  uint sp = 0u;
+  // t < hit.t test), so the hit is the same (docs/benchmarks.md, Session 5, part 4).
+  BVH_STACK_VARS
   uint ref = 0u;  // the root, an inner node
   while (true) {
-    // Inner nodes until this lane holds a leaf (an empty stack ends as the empty leaf kBvhEmptyRef).
+    // Inner nodes until this lane holds a leaf (or the empty leaf: see BVH_INNER_STEP).
     while ((ref & kBvhLeafBit) == 0u) {
       uvec4 r;
       vec4 t;
       uint hits = bvhVisitWide(ref, org, invDir, hit.t, r, t);
-      // Entered children 1..hits-1, farthest first so that child 1 ends on top (packBvhWideNodes
-      // guarantees sp + 3 <= the stack size; the check only guards memory).
-      if (hits > 1u && sp + 3u <= uint(CAUSTICA_BVH_WIDE_STACK)) {
-        if (hits == 4u) stackRef[sp++] = r.w;
-        if (hits >= 3u) stackRef[sp++] = r.z;
-        stackRef[sp++] = r.y;
-      }
-      if (hits > 0u) {
-        ref = r.x;
-      } else if (sp > 0u) {
-        ref = stackRef[--sp];
-      } else {
-        ref = kBvhEmptyRef;
-      }
+      BVH_INNER_STEP
     }
     uint first = ref & kBvhFirstMask;
     uint count = (ref >> kBvhCountShift) & 15u;
@@ -181,8 +256,7 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
         hit.tri = i;
       }
     }
-    if (sp == 0u) break;
-    ref = stackRef[--sp];  // the nearest stacked subtree
+    BVH_OUTER_STEP
   }
   return hit.tri != kInvalidIndex;
 }
@@ -194,26 +268,14 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   vec3 invDir = safeInverse(dir);
   RayShear rs = makeRayShear(dir);
 
-  uint stackRef[CAUSTICA_BVH_WIDE_STACK];
-  uint sp = 0u;
+  BVH_STACK_VARS
   uint ref = 0u;
   while (true) {
     while ((ref & kBvhLeafBit) == 0u) {
       uvec4 r;
       vec4 t;
       uint hits = bvhVisitWide(ref, org, invDir, tmax, r, t);
-      if (hits > 1u && sp + 3u <= uint(CAUSTICA_BVH_WIDE_STACK)) {
-        if (hits == 4u) stackRef[sp++] = r.w;
-        if (hits >= 3u) stackRef[sp++] = r.z;
-        stackRef[sp++] = r.y;
-      }
-      if (hits > 0u) {
-        ref = r.x;
-      } else if (sp > 0u) {
-        ref = stackRef[--sp];
-      } else {
-        ref = kBvhEmptyRef;
-      }
+      BVH_INNER_STEP
     }
     uint first = ref & kBvhFirstMask;
     uint count = (ref >> kBvhCountShift) & 15u;
@@ -227,8 +289,7 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
       if (intersectTriangleSheared(org, rs, p0, p1, p2, tmax, t, u, v)) return true;
 #endif
     }
-    if (sp == 0u) break;
-    ref = stackRef[--sp];
+    BVH_OUTER_STEP
   }
   return false;
 }
