@@ -198,6 +198,14 @@ class BenchRunner {
     const AccumulationState st = renderer.saveAccumulation();
     auto tiles = [&](int tile) { return tileRelVariance(st.accum, st.comp, st.half, ref.image, tile); };
     const std::vector<double> v4 = tiles(4);
+    {  // per pixel (row-major): the per-sample relative variance, reference-weighted, from the halves, for
+       // analyses across renders (scripts/adaptive-ceiling; docs/benchmarks.md, "Adaptive sampling")
+      std::ofstream f(outDir_ + "/" + name + "-" + dispersionModeName(mode) + "-pixel-variance.txt");
+      f << "# " << ref.image.width << "x" << ref.image.height << " pixels, row-major: per-sample relative variance "
+        << "from the halves (uniform render, seed " << run.seed << ", " << spp << " spp)\n";
+      const std::vector<double> v1 = tiles(1);
+      for (double x : v1) f << formatDouble("%.6g", x) << '\n';
+    }
     double meanV = 0.0;
     for (double x : v4) meanV += x / static_cast<double>(v4.size());
     const double spp01 = meanV / 0.01;
