@@ -66,60 +66,73 @@ uint gLightInstance = 0u;  // instanced scenes: the Scene::instances index of th
 
 // Descends from the root choosing each child in proportion to its importance, u in [0, 1) rescaled at
 // every level. False where no triangle can light p; else tri (TriGeom order) and pmf, its probability.
+// The descent is a bottom-tested loop, one body per level: llvmpipe runs a loop's whole body (masked)
+// in the iteration whose test at the top ends it, so the top-tested loop this was cost one level more
+// per call (on a one-level tree twice the work), plus a separate test of a leaf root. A leaf root runs
+// the body once with the root in both children's places (il + ir > 0 exactly when the root's
+// importance is > 0). The child's link comes from its node record (the same texel lightNodeLink reads).
+// Same arithmetic in the same order as the C++ twin (app/accel/light_tree.cpp), so the same choices.
 bool sampleLightTree(vec3 p, vec3 n, float u, out uint tri, out float pmf) {
   pmf = 0.0;
   tri = 0u;
-  uint i = 0u;
   float prob = 1.0;
-  if ((lightNodeLink(0).y & kLightNodeLeaf) != 0u && !(lightImportance(lightNodeAt(0), p, n) > 0.0)) return false;
-  for (int depth = 0; depth <= CAUSTICA_LIGHT_TREE_DEPTH; ++depth) {
-    uvec4 link = lightNodeLink(i);
-    if ((link.y & kLightNodeLeaf) != 0u) {
-      tri = link.x;
-#ifdef CAUSTICA_INSTANCED
-      gLightInstance = link.y >> kLightNodeInstanceShift;
-#endif
-      pmf = prob;
-      return true;
-    }
-    float il = lightImportance(lightNodeAt(link.x), p, n);
-    float ir = lightImportance(lightNodeAt(link.x + 1u), p, n);
+  uvec4 link = lightNodeLink(0u);
+  bool leaf = (link.y & kLightNodeLeaf) != 0u;
+  int level = 0;  // of the node `link` belongs to
+  do {
+    LightNode nl = lightNodeAt(leaf ? 0u : link.x);
+    LightNode nr = lightNodeAt(leaf ? 0u : link.x + 1u);
+    float il = lightImportance(nl, p, n);
+    float ir = lightImportance(nr, p, n);
     if (!(il + ir > 0.0)) return false;
+    if (leaf) break;  // the root is a leaf and can light p
     float pl = il / (il + ir);
     if (u < pl) {
       u = min(u / pl, 0.99999994);
       prob *= pl;
-      i = link.x;
+      link = nl.link;
     } else {
       u = min((u - pl) / (1.0 - pl), 0.99999994);
       prob *= 1.0 - pl;
-      i = link.x + 1u;
+      link = nr.link;
     }
-  }
-  return false;
+    leaf = (link.y & kLightNodeLeaf) != 0u;
+    ++level;
+  } while (!leaf && level <= CAUSTICA_LIGHT_TREE_DEPTH);
+  if (!leaf || level > CAUSTICA_LIGHT_TREE_DEPTH) return false;
+  tri = link.x;
+#ifdef CAUSTICA_INSTANCED
+  gLightInstance = link.y >> kLightNodeInstanceShift;
+#endif
+  pmf = prob;
+  return true;
 }
 
 // The probability that sampleLightTree(p, n) chooses the triangle of leaf node `leaf`: the same choices
-// repeated along the leaf's bit trail.
+// repeated along the leaf's bit trail. A bottom-tested loop as above (one body per level; a leaf root,
+// depth 0, runs it once with the root in both places: 1 where its importance is > 0, else 0).
 float lightTreePdf(vec3 p, vec3 n, uint leaf) {
   uvec4 leafLink = lightNodeLink(leaf);
   uint trail = leafLink.z, depth = leafLink.w;
-  if (depth == 0u) return lightImportance(lightNodeAt(0), p, n) > 0.0 ? 1.0 : 0.0;
-  uint i = 0u;
+  uint left = depth == 0u ? 0u : lightNodeLink(0u).x;
   float prob = 1.0;
-  for (uint k = 0u; k < depth; ++k) {
-    uint left = lightNodeLink(i).x;
-    float il = lightImportance(lightNodeAt(left), p, n);
-    float ir = lightImportance(lightNodeAt(left + 1u), p, n);
+  uint k = 0u;
+  do {
+    LightNode nl = lightNodeAt(left);
+    LightNode nr = lightNodeAt(depth == 0u ? 0u : left + 1u);
+    float il = lightImportance(nl, p, n);
+    float ir = lightImportance(nr, p, n);
     if (!(il + ir > 0.0)) return 0.0;
+    if (depth == 0u) return 1.0;
     float pl = il / (il + ir);
     if (((trail >> k) & 1u) != 0u) {
       prob *= 1.0 - pl;
-      i = left + 1u;
+      left = nr.link.x;
     } else {
       prob *= pl;
-      i = left;
+      left = nl.link.x;
     }
-  }
+    ++k;
+  } while (k < depth);
   return prob;
 }
