@@ -255,8 +255,15 @@ bool pathBounce(inout PathState s) {
 #if defined(CAUSTICA_MIS) || defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_GGX)
     // The vertex as every light estimate below sees it (vertex.glsl), built once: the Lambertian lobe
     // (roughness and eta 1) or the GGX lobe.
-    Vertex v = makeVertex(makeBsdf(m, lobe, base.rgb, diffuse ? 1.0 : metalRough.y, eta), p, pError, ng, ns, s.dir,
-                          s.sigma, sigmaBelow);
+    // Without GGX the lobe here is the Lambertian one: said as a constant, so that the GGX code of
+    // vertexEval / vertexPdf (bsdfEvalPdf) folds away instead of running masked on every bounce.
+#ifdef CAUSTICA_GGX
+    uint vertexLobe = lobe;
+#else
+    const uint vertexLobe = kLobeDiffuse;
+#endif
+    Vertex v = makeVertex(makeBsdf(m, vertexLobe, base.rgb, diffuse ? 1.0 : metalRough.y, eta), p, pError, ng, ns,
+                          s.dir, s.sigma, sigmaBelow);
 #endif
 #ifdef CAUSTICA_MIS
     // Light sampling only where the BSDF-sampled ray that competes with it in MIS will still be
@@ -289,8 +296,12 @@ bool pathBounce(inout PathState s) {
       s.beta *= base.rgb * (cosOut * INV_PI / pdfDir);
       s.prevPdf = pdfDir;
 #else
+#if defined(CAUSTICA_MIS) || defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_GGX)
+      vec3 t = v.t, b = v.b;  // makeVertex's basis about the same ns: not computed twice
+#else
       vec3 t, b;
       orthonormalBasis(ns, t, b);
+#endif
       vec3 local = sampleCosineHemisphere(rand2(s.rng));
       newDir = normalize(local.x * t + local.y * b + local.z * ns);
       float cosOut = dot(newDir, ns);

@@ -136,6 +136,11 @@ float bsdfPdf(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi) {
   return p * ps + (1.0f - p) * wi.z * kInvPi;
 }
 
+float bsdfEvalPdf(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi, glm::vec3& f) {
+  f = bsdfEval(b, wo, wi);
+  return bsdfPdf(b, wo, wi);
+}
+
 bool bsdfSample(const Bsdf& b, const glm::vec3& wo, const glm::vec3& u, BsdfSample& s) {
   s = BsdfSample{};
   if (wo.z <= 0.0f) return false;

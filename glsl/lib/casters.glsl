@@ -101,11 +101,21 @@ float diffuseDirectionPdf(vec3 n, vec3 w) {
 
 // Diffuse bounce direction at the prepared vertex (unit normal n): with probability casters.params.x
 // (when a caster is usable) a uniform direction in the picked caster's cone, else a cosine-weighted one.
+// sampleUniformCone and sampleCosineHemisphere written as one body with per-lane selected inputs (the
+// same arithmetic for each: llvmpipe runs both sides of a branch, so two bodies cost two cos/sin pairs,
+// two bases and two normalisations on every bounce).
 vec3 sampleDiffuseDirection(vec3 n, float uPick, vec2 u) {
-  if (gCasterUsable > 0u && uPick < casters.params.x)
-    return sampleUniformCone(gCasterAxis[gCasterPick], gCasterOneMinusCos[gCasterPick], u);
+  bool cone = gCasterUsable > 0u && uPick < casters.params.x;
+  vec3 axis = n;
+  float omcT = 0.0;
+  if (cone) {
+    axis = gCasterAxis[gCasterPick];
+    omcT = u.x * gCasterOneMinusCos[gCasterPick];  // 1 - cos(theta)
+  }
+  float s = sqrt(cone ? max(0.0, omcT * (2.0 - omcT)) : u.x);  // sin(theta)
+  float z = cone ? 1.0 - omcT : sqrt(max(0.0, 1.0 - u.x));      // cos(theta)
+  float phi = 2.0 * PI * u.y;
   vec3 t, b;
-  orthonormalBasis(n, t, b);
-  vec3 local = sampleCosineHemisphere(u);
-  return normalize(local.x * t + local.y * b + local.z * n);
+  orthonormalBasis(axis, t, b);
+  return normalize(s * cos(phi) * t + s * sin(phi) * b + z * axis);
 }

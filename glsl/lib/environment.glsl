@@ -61,23 +61,25 @@ float environmentPdf(vec3 d) {
 // False (nothing drawn) only at a pole, where the density is undefined.
 bool sampleEnvironment(vec2 u, out vec3 dir, out vec3 le, out float pdf) {
   int w = int(environment.size.x), h = int(environment.size.y);
-  // Row: smallest y with marginal CDF > u.y (binary search; the same loop as the C++ twin).
+  // Row: smallest y with marginal CDF > u.y (binary search; the same steps as the C++ twin). Bottom-tested
+  // loops: llvmpipe runs a loop's whole body (masked) in the iteration whose test at the top ends it, so
+  // `while (lo < hi)` cost one CDF fetch and step more than the search (docs/benchmarks.md, "Session 7").
   int lo = 0, hi = h - 1;
-  while (lo < hi) {
+  if (lo < hi) do {
     int mid = (lo + hi) / 2;
     if (envMarginalCdf(mid) > u.y) hi = mid;
     else lo = mid + 1;
-  }
+  } while (lo < hi);
   int y = lo;
   float m0 = y > 0 ? envMarginalCdf(y - 1) : 0.0;
   float rowProb = envMarginalCdf(y) - m0;
   lo = 0;
   hi = w - 1;
-  while (lo < hi) {
+  if (lo < hi) do {
     int mid = (lo + hi) / 2;
     if (envConditionalCdf(mid, y) > u.x) hi = mid;
     else lo = mid + 1;
-  }
+  } while (lo < hi);
   int x = lo;
   float c0 = x > 0 ? envConditionalCdf(x - 1, y) : 0.0;
   vec4 texel = texelFetch(envMap, ivec2(x, y), 0);

@@ -48,10 +48,11 @@ bool environmentVisible(vec3 p, vec3 pError, vec3 ng, vec3 wi) {
 vec3 addEnvironmentLight(Vertex v, vec2 u) {
   EnvLightSample es;
   if (!environmentPresent() || !sampleEnvironment(u, es.wi, es.le, es.pdf) || !(es.pdf > 0.0)) return vec3(0.0);
-  vec3 f = vertexEval(v, es.wi);
+  float pdfVertex;
+  vec3 f = vertexEvalPdf(v, es.wi, pdfVertex);
   if (!(maxComponent(f) > 0.0)) return vec3(0.0);
   bool above = dot(v.ng, es.wi) > 0.0;  // transmission lobes reach the sky through the surface
   if (!environmentVisible(v.p, v.pError, above ? v.ng : -v.ng, es.wi)) return vec3(0.0);
-  float w = powerHeuristic(es.pdf, vertexPdf(v, es.wi));
+  float w = powerHeuristic(es.pdf, pdfVertex);
   return f * (w / es.pdf) * es.le;
 }

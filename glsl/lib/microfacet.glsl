@@ -14,6 +14,21 @@ const uint kLobeRoughGlass = 5u;  // rough dielectric: GGX reflection and refrac
 const float kDeltaAlpha = 1.0e-3;       // below this GGX alpha a metal or glass lobe is the delta lobe
 const float kMinPlasticAlpha = 1.0e-3;  // the plastic lobe's alpha is at least this
 
+// Whether lobe l is rough glass / rough metal. With CAUSTICA_GGX set (a path tracer or Whitted variant)
+// chooseLobe makes rough glass only with CAUSTICA_GLASS and rough metal only with CAUSTICA_MIRROR, so
+// without them the test is a constant and that lobe's code folds away (llvmpipe would run it masked
+// on every call). Without CAUSTICA_GGX (the twin tests) every lobe is possible.
+#if defined(CAUSTICA_GGX) && !defined(CAUSTICA_GLASS)
+#define CAUSTICA_IS_ROUGH_GLASS(l) false
+#else
+#define CAUSTICA_IS_ROUGH_GLASS(l) ((l) == kLobeRoughGlass)
+#endif
+#if defined(CAUSTICA_GGX) && !defined(CAUSTICA_MIRROR)
+#define CAUSTICA_IS_CONDUCTOR(l) false
+#else
+#define CAUSTICA_IS_CONDUCTOR(l) ((l) == kLobeConductor)
+#endif
+
 // One lobe with its parameters at a shading point.
 struct Bsdf {
   uint lobe;
@@ -94,61 +109,74 @@ float plasticSpecularProbability(Bsdf b, vec3 wo) {
   return clamp(p, 0.1, 0.9);
 }
 
+// f(wo, wi) without the cosine (out f) and the solid-angle density with which bsdfSample produces wi
+// (returned); both 0 where the lobe has no value. One body for every lobe: llvmpipe runs both sides of
+// every branch for all 8 SIMD lanes, so the half vector (generalised for rough glass, wo + wi
+// normalised otherwise: etap = 1 there, and wi * 1 + wo is wo + wi exactly), D, Lambda(wo), Lambda(wi)
+// and the Schlick term are computed once with per-lane selected inputs, not once per lobe, and f and
+// the pdf share them. Each lobe's value is the same arithmetic in the same order as the C++ twins
+// bsdfEval and bsdfPdf (app/shading/microfacet.cpp), so bit for bit what separate code gave.
+float bsdfEvalPdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f) {
+  f = vec3(0.0);
+  if (wo.z <= 0.0) return 0.0;
+  bool roughGlass = CAUSTICA_IS_ROUGH_GLASS(b.lobe);
+  if (roughGlass ? wi.z == 0.0 : wi.z <= 0.0) return 0.0;
+  if (b.lobe == kLobeDiffuse) {
+    f = b.color * INV_PI;
+    return wi.z * INV_PI;
+  }
+  bool refl = wi.z > 0.0;  // always outside rough glass
+  float etap = refl ? 1.0 : b.eta;
+  vec3 m = wi * etap + wo;  // generalizedHalf's arithmetic; the reflection half vector when etap = 1
+  float len = length(m);
+  if (!(len > 0.0)) return 0.0;
+  m /= len;
+  if (roughGlass) {
+    if (m.z < 0.0) m = -m;
+    if (m.z == 0.0 || !(dot(m, wi) * wi.z >= 0.0 && dot(m, wo) * wo.z >= 0.0)) return 0.0;
+  }
+  float d = ggxD(m, b.alpha);
+  float lambdaO = ggxLambda(wo, b.alpha);
+  float g2 = 1.0 / (1.0 + lambdaO + ggxLambda(wi, b.alpha));  // ggxG2
+  float cosM = dot(wo, m);
+  float pm = 1.0 / (1.0 + lambdaO) * max(0.0, cosM) * d / wo.z;  // ggxVisibleNormalPdf (wo.z > 0 here)
+  if (roughGlass) {
+    float fr = fresnelDielectric(cosM, b.eta);
+    float dg = d * g2;
+    if (refl) {
+      f = vec3(dg * fr / (4.0 * wi.z * wo.z));
+      return pm / (4.0 * abs(cosM)) * fr;
+    }
+    float cosI = dot(wi, m);
+    float s = cosI + cosM / etap;
+    float denom = s * s * wi.z * wo.z;
+    f = b.color * (dg * (1.0 - fr) * abs(cosI * cosM / denom) / (etap * etap));
+    return pm * abs(cosI) / (s * s) * (1.0 - fr);
+  }
+  float spec = d * g2 / (4.0 * wo.z * wi.z);
+  float ps = pm / (4.0 * cosM);
+  bool conductor = CAUSTICA_IS_CONDUCTOR(b.lobe);
+  vec3 fs = fresnelSchlick(conductor ? b.color : b.f0, conductor ? vec3(1.0) : vec3(b.f90), cosM);
+  if (conductor) {
+    f = fs * spec;
+    return ps;
+  }
+  f = fs * spec + (1.0 - maxComponent(fs)) * b.color * INV_PI;
+  float p = plasticSpecularProbability(b, wo);
+  return p * ps + (1.0 - p) * wi.z * INV_PI;
+}
+
 // f(wo, wi) without the cosine; 0 where the lobe has no value.
 vec3 bsdfEval(Bsdf b, vec3 wo, vec3 wi) {
-  if (wo.z <= 0.0) return vec3(0.0);
-  if (b.lobe == kLobeRoughGlass) {
-    if (wi.z == 0.0) return vec3(0.0);
-    bool refl = wi.z > 0.0;
-    float etap = refl ? 1.0 : b.eta;
-    vec3 wm;
-    if (!generalizedHalf(wo, wi, etap, wm)) return vec3(0.0);
-    float f = fresnelDielectric(dot(wo, wm), b.eta);
-    float dg = ggxD(wm, b.alpha) * ggxG2(wo, wi, b.alpha);
-    if (refl) return vec3(dg * f / (4.0 * wi.z * wo.z));
-    float s = dot(wi, wm) + dot(wo, wm) / etap;
-    float denom = s * s * wi.z * wo.z;
-    float t = dg * (1.0 - f) * abs(dot(wi, wm) * dot(wo, wm) / denom) / (etap * etap);
-    return b.color * t;
-  }
-  if (wi.z <= 0.0) return vec3(0.0);
-  if (b.lobe == kLobeDiffuse) return b.color * INV_PI;
-  vec3 h = wo + wi;
-  float len = length(h);
-  if (!(len > 0.0)) return vec3(0.0);
-  h /= len;
-  float spec = ggxD(h, b.alpha) * ggxG2(wo, wi, b.alpha) / (4.0 * wo.z * wi.z);
-  float cosH = dot(wo, h);
-  if (b.lobe == kLobeConductor) return fresnelSchlick(b.color, vec3(1.0), cosH) * spec;
-  vec3 f = fresnelSchlick(b.f0, vec3(b.f90), cosH);
-  return f * spec + (1.0 - maxComponent(f)) * b.color * INV_PI;
+  vec3 f;
+  bsdfEvalPdf(b, wo, wi, f);
+  return f;
 }
 
 // Solid-angle density with which bsdfSample produces wi.
 float bsdfPdf(Bsdf b, vec3 wo, vec3 wi) {
-  if (wo.z <= 0.0) return 0.0;
-  if (b.lobe == kLobeRoughGlass) {
-    if (wi.z == 0.0) return 0.0;
-    bool refl = wi.z > 0.0;
-    float etap = refl ? 1.0 : b.eta;
-    vec3 wm;
-    if (!generalizedHalf(wo, wi, etap, wm)) return 0.0;
-    float f = fresnelDielectric(dot(wo, wm), b.eta);
-    float pm = ggxVisibleNormalPdf(wo, wm, b.alpha);
-    if (refl) return pm / (4.0 * abs(dot(wo, wm))) * f;
-    float s = dot(wi, wm) + dot(wo, wm) / etap;
-    return pm * abs(dot(wi, wm)) / (s * s) * (1.0 - f);
-  }
-  if (wi.z <= 0.0) return 0.0;
-  if (b.lobe == kLobeDiffuse) return wi.z * INV_PI;
-  vec3 h = wo + wi;
-  float len = length(h);
-  if (!(len > 0.0)) return 0.0;
-  h /= len;
-  float ps = ggxVisibleNormalPdf(wo, h, b.alpha) / (4.0 * dot(wo, h));
-  if (b.lobe == kLobeConductor) return ps;
-  float p = plasticSpecularProbability(b, wo);
-  return p * ps + (1.0 - p) * wi.z * INV_PI;
+  vec3 f;
+  return bsdfEvalPdf(b, wo, wi, f);
 }
 
 // Samples wi; u.x chooses the part (specular or diffuse, reflection or refraction), u.yz the direction.
@@ -160,26 +188,26 @@ bool bsdfSample(Bsdf b, vec3 wo, vec3 u, out BsdfSample s) {
   s.transmitted = false;
   if (wo.z <= 0.0) return false;
   vec2 uDir = u.yz;
-  if (b.lobe == kLobeRoughGlass) {
-    vec3 wm = ggxSampleVisibleNormal(wo, b.alpha, uDir);
-    float f = fresnelDielectric(dot(wo, wm), b.eta);
-    if (u.x < f) {
-      s.wi = reflectAbout(wo, wm);
-      if (s.wi.z <= 0.0) return false;
-    } else {
-      if (!refractDir(-wo, wm, 1.0 / b.eta, s.wi) || s.wi.z >= 0.0) return false;
-      s.transmitted = true;
-    }
-  } else if (b.lobe == kLobeDiffuse) {
-    s.wi = sampleCosineHemisphere(uDir);
-  } else if (b.lobe == kLobeConductor || u.x < plasticSpecularProbability(b, wo)) {
-    s.wi = reflectAbout(wo, ggxSampleVisibleNormal(wo, b.alpha, uDir));
+  // One call of each direction sampler and of reflectAbout for every lobe (llvmpipe runs every branch):
+  // a visible normal for rough glass, rough metal and plastic's specular part, a cosine direction for
+  // the diffuse lobe and plastic's diffuse part.
+  bool roughGlass = CAUSTICA_IS_ROUGH_GLASS(b.lobe);
+  vec3 wm = ggxSampleVisibleNormal(wo, b.alpha, uDir);
+  float f = fresnelDielectric(dot(wo, wm), b.eta);  // rough glass only
+  bool specular = roughGlass ? u.x < f
+                             : b.lobe != kLobeDiffuse && (CAUSTICA_IS_CONDUCTOR(b.lobe) || u.x < plasticSpecularProbability(b, wo));
+  if (roughGlass && !specular) {
+    if (!refractDir(-wo, wm, 1.0 / b.eta, s.wi) || s.wi.z >= 0.0) return false;
+    s.transmitted = true;
+  } else if (specular) {
+    s.wi = reflectAbout(wo, wm);
     if (s.wi.z <= 0.0) return false;
   } else {
     s.wi = sampleCosineHemisphere(uDir);
   }
-  s.pdf = bsdfPdf(b, wo, s.wi);
+  vec3 fv;
+  s.pdf = bsdfEvalPdf(b, wo, s.wi, fv);
   if (!(s.pdf > 0.0)) return false;
-  s.weight = bsdfEval(b, wo, s.wi) * (abs(s.wi.z) / s.pdf);
+  s.weight = fv * (abs(s.wi.z) / s.pdf);
   return true;
 }

@@ -16,11 +16,11 @@ layout(std140, binding = CAUSTICA_BINDING_PUNCTUAL) uniform PunctualBlock { Punc
 // The light whose cumulative selection probability first exceeds u (binary search; u in [0, 1)).
 uint pickPunctualLight(float u) {
   uint lo = 0u, hi = punctual.count.x - 1u;
-  while (lo < hi) {
+  if (lo < hi) do {  // bottom-tested: no extra masked step at the end (environment.glsl, sampleEnvironment)
     uint mid = (lo + hi) / 2u;
     if (u < punctual.light[mid].select.y) hi = mid;
     else lo = mid + 1u;
-  }
+  } while (lo < hi);
   return lo;
 }
 

@@ -172,7 +172,9 @@ void main() {
     o[0] = bits(h, ggxVisibleNormalPdf(a[0].xyz, h, a[0].w));
   } else if (function == kBsdfEvalPdf) {  // a[0].xyz = wo, a[1].xyz = wi: f, pdf
     Bsdf b = recordBsdf(a);
-    o[0] = bits(bsdfEval(b, a[0].xyz, a[1].xyz), bsdfPdf(b, a[0].xyz, a[1].xyz));
+    vec3 f;  // bsdfEvalPdf: bsdfEval and bsdfPdf in one body (the path tracer's vertexEvalPdf and bsdfSample call it)
+    float pdf = bsdfEvalPdf(b, a[0].xyz, a[1].xyz, f);
+    o[0] = bits(f, pdf);
   } else if (function == kBsdfSample) {  // a[0].xyz = wo, a[1].xyz = u: wi, pdf, weight, transmitted, ok
     BsdfSample bs;
     bool ok = bsdfSample(recordBsdf(a), a[0].xyz, a[1].xyz, bs);
