@@ -7,8 +7,8 @@
 #include "lib/sampling.glsl"
 #include "lib/spawn.glsl"
 #include "lib/intersect.glsl"
-bool whittedOccluder(uint tri);  // below: emitters do not occlude in this mode
-#define CAUSTICA_OCCLUDER_FILTER(tri) whittedOccluder(tri)
+bool whittedOccluder(uint material);  // below: emitters do not occlude in this mode
+#define CAUSTICA_OCCLUDER_FILTER(tri, material) whittedOccluder(material)
 #include "lib/traverse.glsl"
 #include "lib/camera.glsl"
 #include "lib/textures.glsl"
@@ -56,7 +56,8 @@ void pushRay(vec3 org, vec3 dir, vec3 weight, vec3 sigma, uint depth) {
 // Any hit with 0 < t < tmax that is not an emitter: the point lights stand in for the emissive
 // triangles, which therefore cast no shadows (a light's centre may lie inside its closed mesh).
 // traceOccluded with whittedOccluder as its filter (traverse.glsl, CAUSTICA_OCCLUDER_FILTER).
-bool whittedOccluder(uint tri) { return !isEmissive(materialAt(floatBitsToUint(triGeomAt(tri).v0.w))); }
+// material: the tested triangle's TriGeom.v0.w, fetched with its positions.
+bool whittedOccluder(uint material) { return !isEmissive(materialAt(material)); }
 bool occludedByNonEmitter(vec3 org, vec3 dir, float tmax) { return traceOccluded(org, dir, tmax); }
 
 // Direct light from every point light at p, with a sharp shadow ray each (radiance towards wv).

@@ -714,6 +714,18 @@ double bvhSahCost(const std::vector<gpu::BvhNode>& nodes, float costTraversal, f
   return cost;
 }
 
+bool isZeroAreaTriangle(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
+  const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
+  return n.x == 0.0f && n.y == 0.0f && n.z == 0.0f;
+}
+
+void packedTrianglePositions(const glm::vec3* p, glm::vec3& q0, glm::vec3& q1, glm::vec3& q2) {
+  const bool point = isZeroAreaTriangle(p[0], p[1], p[2]);
+  q0 = p[0];
+  q1 = point ? p[0] : p[1];
+  q2 = point ? p[0] : p[2];
+}
+
 void appendTriGeom(const Triangle* triangles, std::size_t count, const Bvh& bvh, std::vector<gpu::TriGeom>& out) {
   if (bvh.order.size() != count)
     throw Error("bvh.cpp: BVH was built for " + std::to_string(bvh.order.size()) + " triangles, got " +
@@ -722,9 +734,11 @@ void appendTriGeom(const Triangle* triangles, std::size_t count, const Bvh& bvh,
   out.resize(base + count);
   for (std::size_t i = 0; i < count; ++i) {
     const Triangle& t = triangles[bvh.order[i]];
-    out[base + i].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
-    out[base + i].v1 = glm::vec4(t.p[1], 0.0f);
-    out[base + i].v2 = glm::vec4(t.p[2], 0.0f);
+    glm::vec3 q0, q1, q2;
+    packedTrianglePositions(t.p, q0, q1, q2);
+    out[base + i].v0 = glm::vec4(q0, glm::uintBitsToFloat(t.material));
+    out[base + i].v1 = glm::vec4(q1, 0.0f);
+    out[base + i].v2 = glm::vec4(q2, 0.0f);
   }
 }
 
@@ -782,9 +796,11 @@ bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const
   if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
   const float det = e0 + e1 + e2;
   if (det == 0.0f) return false;  // ray in the triangle's plane
-  // Zero-area triangles can pass the test above once their vertices are rounded in ray space.
-  const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
-  if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return false;
+  // Zero-area triangles can pass the test above once their vertices are rounded in ray space (in a
+  // scratch search the t error bound below then rejected every one, docs/benchmarks.md "Session 7",
+  // but that is not proven). The GLSL twin has no such check: packedTrianglePositions stores them as
+  // one point, which det == 0 rejects; this check keeps the reference right for any vertices.
+  if (isZeroAreaTriangle(p0, p1, p2)) return false;
 
   const float az = sz * a.z, bz = sz * b.z, cz = sz * c.z;
   const float tScaled = e0 * az + e1 * bz + e2 * cz;

@@ -46,7 +46,15 @@ bool bvhBounds(const std::vector<gpu::BvhNode>& nodes, glm::vec3& lo, glm::vec3&
 // box's area. Equals Bvh::sahCost up to rounding (summed in another order).
 double bvhSahCost(const std::vector<gpu::BvhNode>& nodes, float costTraversal = 1.0f, float costIntersect = 1.0f);
 
-// Packs triangle positions in BVH leaf order (TriGeom.v0.w carries the material index bits).
+// True when cross(p1 - p0, p2 - p0), computed in float, is exactly 0: a triangle that never hits.
+bool isZeroAreaTriangle(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2);
+// The positions a TriGeom stores for triangle p[3]: p itself, or, for a zero-area triangle, p[0] three
+// times (the GLSL triangle test has no zero-area check: a point is rejected by its det == 0, see
+// intersect.glsl). Every packer of TriGeom goes through this.
+void packedTrianglePositions(const glm::vec3* p, glm::vec3& q0, glm::vec3& q1, glm::vec3& q2);
+
+// Packs triangle positions in BVH leaf order (TriGeom.v0.w carries the material index bits; zero-area
+// triangles as one point, packedTrianglePositions).
 std::vector<gpu::TriGeom> packTriGeom(const std::vector<Triangle>& triangles, const Bvh& bvh);
 // packTriGeom of `count` triangles at `triangles`, appended to `out`.
 void appendTriGeom(const Triangle* triangles, std::size_t count, const Bvh& bvh, std::vector<gpu::TriGeom>& out);
@@ -73,7 +81,9 @@ struct RayShear {
 };
 RayShear makeRayShear(const glm::vec3& dir);
 
-// intersectTriangle with the ray's shear precomputed. Twin of intersectTriangleSheared() in intersect.glsl.
+// intersectTriangle with the ray's shear precomputed. Twin of intersectTriangleSheared() in intersect.glsl,
+// which has no zero-area test of its own (it relies on packedTrianglePositions; the same hits on
+// packed TriGeom, see there) and is written as straight-line code for llvmpipe (the same decisions).
 bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const glm::vec3& p0, const glm::vec3& p1,
                               const glm::vec3& p2, float tmax, float& t, float& u, float& v);
 

@@ -160,9 +160,11 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
     const std::size_t i = first + j;
     const Triangle& t = scene.triangles[bvh.order[i]];
     const std::uint32_t leaf = g.lightTree.leafOf[i];
-    geom[j].v0 = glm::vec4(t.p[0], glm::uintBitsToFloat(t.material));
-    geom[j].v1 = glm::vec4(t.p[1], glm::uintBitsToFloat(leaf == gpu::kInvalidIndex ? 0u : leaf + 1u));
-    geom[j].v2 = glm::vec4(t.p[2], 0.0f);
+    glm::vec3 q0, q1, q2;
+    packedTrianglePositions(t.p, q0, q1, q2);  // a zero-area triangle as one point (intersect.glsl)
+    geom[j].v0 = glm::vec4(q0, glm::uintBitsToFloat(t.material));
+    geom[j].v1 = glm::vec4(q1, glm::uintBitsToFloat(leaf == gpu::kInvalidIndex ? 0u : leaf + 1u));
+    geom[j].v2 = glm::vec4(q2, 0.0f);
     writeTriShade(scene, bvh.order[i], g.triShadeStride, shade.data() + j * g.triShadeStride);
   }
 }

@@ -14,7 +14,8 @@
 //     (rmax, 0); boxes as float bits in world space. A ref with kBvhLeafBit clear is an inner node's
 //     index; else a leaf over triGeom[first .. first + count - 1] (first = ref & kBvhFirstMask,
 //     count = ref >> kBvhCountShift & 15; count 0: an empty slot). nodes[0] is the root.
-//   TriGeom i = texels 3i..3i+2 of triGeomTexels: v0.xyz, v1.xyz, v2.xyz as float bits, world space.
+//   TriGeom i = texels 3i..3i+2 of triGeomTexels: v0.xyz, v1.xyz, v2.xyz as float bits, world space
+//     (a zero-area triangle as v0 three times); v0.w = material index bits.
 //   Binary tree depth (root = 1) is < CAUSTICA_BVH_STACK and the binary near-first traversal
 //   (traverse_instanced.glsl) pushes at most one ref per level; the sp checks only guard memory.
 //
@@ -59,11 +60,14 @@ uint bvhVisitNode(uint index, vec3 org, vec3 invDir, float tmax, out uint near, 
   return (hl ? 1u : 0u) + (hr ? 1u : 0u);
 }
 
-// Positions of triangle i (leaf order).
-void bvhTriangle(uint i, out vec3 p0, out vec3 p1, out vec3 p2) {
-  p0 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i)).xyz);
+// Positions of triangle i (leaf order); returns its material index (TriGeom.v0.w, the first texel's
+// fourth word), for a CAUSTICA_OCCLUDER_FILTER that would otherwise fetch the triangle again.
+uint bvhTriangle(uint i, out vec3 p0, out vec3 p1, out vec3 p2) {
+  uvec4 a = texelFetch(triGeomTexels, int(3u * i));
+  p0 = uintBitsToFloat(a.xyz);
   p1 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i + 1u)).xyz);
   p2 = uintBitsToFloat(texelFetch(triGeomTexels, int(3u * i + 2u)).xyz);
+  return a.w;
 }
 
 // Entry distance given to a child the ray misses: above any entered child's (<= tmax * kBvhBoxPad <= 3e38 * pad).
@@ -261,9 +265,10 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   return hit.tri != kInvalidIndex;
 }
 
-// Any hit with 0 < t < tmax (shadow rays). An includer may define CAUSTICA_OCCLUDER_FILTER(tri) (a
-// bool expression of the triangle's leaf-order index) before including this file: triangles for which
-// it is false do not occlude (Whitted: emitters cast no shadows there).
+// Any hit with 0 < t < tmax (shadow rays). An includer may define CAUSTICA_OCCLUDER_FILTER(tri, material)
+// (a bool expression of the triangle's leaf-order index and its material index, TriGeom.v0.w) before
+// including this file: triangles for which it is false do not occlude (Whitted: emitters cast no
+// shadows there). The material comes with the positions' texels (no second fetch of the triangle).
 bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   vec3 invDir = safeInverse(dir);
   RayShear rs = makeRayShear(dir);
@@ -281,10 +286,10 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
     uint count = (ref >> kBvhCountShift) & 15u;
     for (uint i = first; i < first + count; ++i) {
       vec3 p0, p1, p2;
-      bvhTriangle(i, p0, p1, p2);
+      uint material = bvhTriangle(i, p0, p1, p2);
       float t, u, v;
 #ifdef CAUSTICA_OCCLUDER_FILTER
-      if (intersectTriangleSheared(org, rs, p0, p1, p2, tmax, t, u, v) && CAUSTICA_OCCLUDER_FILTER(i)) return true;
+      if (intersectTriangleSheared(org, rs, p0, p1, p2, tmax, t, u, v) && CAUSTICA_OCCLUDER_FILTER(i, material)) return true;
 #else
       if (intersectTriangleSheared(org, rs, p0, p1, p2, tmax, t, u, v)) return true;
 #endif

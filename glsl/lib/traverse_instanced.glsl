@@ -72,11 +72,11 @@ bool traceInstanced(vec3 worldOrg, vec3 worldDir, float tmax, uint recordBase, b
       uint count = (ref >> kBvhCountShift) & 15u;
       for (uint i = first; i < first + count; ++i) {
         vec3 p0, p1, p2;
-        bvhTriangle(i, p0, p1, p2);
+        uint material = bvhTriangle(i, p0, p1, p2);
         float t, u, v;
         if (intersectTriangleSheared(org, rs, p0, p1, p2, hit.t, t, u, v)) {
 #ifdef CAUSTICA_OCCLUDER_FILTER
-          if (anyHit && !CAUSTICA_OCCLUDER_FILTER(i)) continue;  // traverse.glsl's filter (Whitted)
+          if (anyHit && !CAUSTICA_OCCLUDER_FILTER(i, material)) continue;  // traverse.glsl's filter (Whitted)
 #endif
           hit.t = t;
           hit.u = u;

@@ -153,7 +153,8 @@ struct InstanceShade {
 };
 CAUSTICA_CONST uint kInstanceMirrored = 1u;
 
-// Triangle positions for intersection (48 bytes).
+// Triangle positions for intersection (48 bytes). A zero-area triangle is stored as one point, v0.xyz
+// three times (packedTrianglePositions, app/accel/bvh.h): the GLSL test rejects it by det == 0.
 struct TriGeom {
   vec4 v0;  // xyz: vertex 0 (world space); w: material index (stored as float bits of a uint)
   vec4 v1;  // xyz: vertex 1; w: emissive triangles: light-tree leaf index + 1 (uint bits), else 0;

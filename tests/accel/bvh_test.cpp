@@ -397,6 +397,33 @@ TEST_CASE("intersectTriangle: degenerate and non-finite triangles never hit") {
   CHECK(hits == 0);
 }
 
+TEST_CASE("packTriGeom: zero-area triangles are stored as one point, the others as they are") {
+  // intersect.glsl has no area test of its own: it rejects a point by det == 0 (see there).
+  Rng rng(6);
+  std::vector<Triangle> tris = degenerateTriangles(200, rng);
+  const std::vector<Triangle> soup = randomSoup(200, rng);
+  tris.insert(tris.end(), soup.begin(), soup.end());
+  const Bvh bvh = buildBvh(tris);
+  const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+  REQUIRE(geom.size() == tris.size());
+  int points = 0;
+  for (std::size_t i = 0; i < geom.size(); ++i) {
+    const Triangle& t = tris[bvh.order[i]];
+    const glm::vec3 q0(geom[i].v0), q1(geom[i].v1), q2(geom[i].v2);
+    CHECK(q0 == t.p[0]);
+    if (isZeroAreaTriangle(t.p[0], t.p[1], t.p[2])) {
+      ++points;
+      CHECK(q1 == t.p[0]);
+      CHECK(q2 == t.p[0]);
+    } else {
+      CHECK(q1 == t.p[1]);
+      CHECK(q2 == t.p[2]);
+    }
+    CHECK(glm::floatBitsToUint(geom[i].v0.w) == t.material);
+  }
+  CHECK(points >= 200);  // every one of degenerateTriangles (a random soup has none)
+}
+
 TEST_CASE("bvh: agrees with brute force on the bunny") {
   const std::vector<Triangle> tris = loadBunny();
   REQUIRE(tris.size() == 3674);

@@ -192,6 +192,52 @@ TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never e
   CHECK(cpuEscapes == 0);
 }
 
+TEST_CASE("GPU traversal: zero-area triangles are never hit (packed as one point; the shader has no area test)") {
+  // Collinear triangles with three distinct vertices (p, p + d, p + 3d in both windings) and two-vertex
+  // ones, kept where cross(p1 - p0, p2 - p0) is exactly 0 in float, and rays aimed at points on them
+  // from all sides: in ray space the vertices round off the line, so the edge functions can share a
+  // sign with det != 0. intersect.glsl relies on packTriGeom storing them as one point (det == 0 for
+  // every ray); the C++ twin tests the area itself.
+  std::mt19937 g(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Triangle> tris;
+  for (int i = 0; tris.size() < 400; ++i) {
+    const glm::vec3 p = glm::floor(8.0f * glm::vec3(u(g), u(g), u(g))) * 0.125f;
+    const glm::vec3 d = glm::floor(4.0f * glm::vec3(u(g), u(g), u(g))) * 0.0625f;
+    Triangle t = i % 4 == 3   ? makeTriangle(p, p + 3.0f * d, p + 3.0f * d)
+                 : i % 2 == 0 ? makeTriangle(p, p + d, p + 3.0f * d)
+                              : makeTriangle(p, p + 3.0f * d, p + d);
+    if (d != glm::vec3(0.0f) && isZeroAreaTriangle(t.p[0], t.p[1], t.p[2])) tris.push_back(t);
+  }
+  Bvh bvh = buildBvh(tris);
+  std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
+  std::vector<glm::vec4> rays;
+  std::vector<Ray> cpu;
+  for (const Triangle& t : tris)
+    for (int k = 0; k < 50; ++k) {
+      const glm::vec3 target = glm::mix(t.p[0], t.p[2], float(k % 11) / 10.0f);
+      const glm::vec3 o = target + 2.0f * glm::normalize(glm::vec3(u(g), u(g), u(g)) + 1e-6f);
+      Ray r{o, glm::normalize(target - o)};
+      cpu.push_back(r);
+      rays.push_back(glm::vec4(o, 1e30f));
+      rays.push_back(glm::vec4(r.dir, 0.0f));
+    }
+  std::vector<glm::vec4> hits;
+  std::vector<std::uint32_t> occ;
+  traceOnGpu(bvh, geom, rays, hits, occ);
+  const BvhWide wide = packBvhWideNodes(bvh.nodes);
+  int gpuHits = 0, gpuOccluded = 0, cpuHits = 0;
+  for (std::size_t k = 0; k < cpu.size(); ++k) {
+    gpuHits += glm::floatBitsToUint(hits[k].w) != gpu::kInvalidIndex;
+    gpuOccluded += occ[k] != 0u;
+    cpuHits += traceClosest(wide.nodes, geom, cpu[k], 1e30f).found();
+  }
+  INFO("of ", cpu.size(), " rays: GPU hits ", gpuHits, ", GPU occluded ", gpuOccluded, ", C++ twin hits ", cpuHits);
+  CHECK(gpuHits == 0);
+  CHECK(gpuOccluded == 0);
+  CHECK(cpuHits == 0);
+}
+
 TEST_CASE("reintersect on the GPU: rays spawned from hits on 1,000 triangles (1e-8..1e8) never hit their own triangle") {
   // The triangles of tests/accel/spawn_test.cpp's Reintersect test, all in one BVH: from a hit point on
   // each, 1,000 rays leave through offsetRayOrigin (its GLSL twin is bit-equal, twins_gpu_test) and
