@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
-#include <sstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "accel/ray_box.h"
@@ -151,7 +151,7 @@ class SahCollapse {
   const WideCollapseOptions& opt_;
   std::vector<float> area_;                      // inner node's box's surface area (box as stored in its parent; root: both children's)
   std::vector<std::uint32_t> first_, count_;     // inner node's triangles (count ~0u: not contiguous)
-  std::vector<std::array<float, 5>> best_;       // [n][j], j = 1..4 (float: ~25 B per binary node in all, freed after the collapse)
+  std::vector<std::array<float, 5>> best_;       // [n][j], j = 1..4 (all these: ~40 B per binary node, freed after the collapse)
   std::vector<std::array<std::uint8_t, 5>> split_;  // [n][j]: left child's share of j slots; 0: n takes one slot
   std::vector<std::uint8_t> merge_;              // n in one slot: a merged leaf (else a wide node)
   std::vector<std::uint8_t> wideSplit_;          // n as a wide node: its left child's share of the four slots
