@@ -358,6 +358,7 @@ BvhShape parseBvhShape(const std::string& spec) {
     else if (key == "bct") shape.build.costTraversal = float(number());
     else if (key == "bci") shape.build.costIntersect = float(number());
     else if (key == "bins") shape.build.bins = int(number());
+    else if (key == "bins2") shape.build.secondBins = int(number());
     else throw Error("CAUSTICA_BVH_SHAPE: unknown item '" + item + "'");
   }
   return shape;

@@ -53,7 +53,8 @@ struct BvhShape {
 };
 // The defaults, changed for experiments by $CAUSTICA_BVH_SHAPE, a comma-separated list of key=value:
 // collapse=greedy|sah, wideleaf=N (collapse maxLeafSize), cn=, cl=, ct= (collapse costs), leaf=N
-// (binary maxLeafSize), bct=, bci= (binary SAH costTraversal, costIntersect), bins=N (binary SAH bins). Throws caustica::Error on a
+// (binary maxLeafSize), bct=, bci= (binary SAH costTraversal, costIntersect), bins=N (binary SAH bins), bins2=N
+// (BvhBuildOptions::secondBins; 0: one build). Throws caustica::Error on a
 // malformed value.
 BvhShape bvhShapeFromEnv();
 // The same from a string in that syntax ("" = the defaults).
