@@ -491,8 +491,12 @@ Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions
     BvhBuildOptions o = options;
     o.bins = options.secondBins;
     o.secondBins = 0;
-    Bvh other = buildBvhOnce(triangles, count, o);
-    if (other.sahCost < bvh.sahCost) bvh = std::move(other);
+    try {
+      Bvh other = buildBvhOnce(triangles, count, o);
+      if (other.sahCost < bvh.sahCost) bvh = std::move(other);
+    } catch (const Error&) {
+      // Too deep for the traversal stack with these bins: the first tree stands.
+    }
   }
   return bvh;
 }
