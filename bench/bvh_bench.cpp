@@ -106,6 +106,7 @@ Row measure(const std::string& name, const std::vector<Triangle>& tris, const st
   BvhBuildOptions opt;
   opt.bins = bins;
   opt.maxLeafSize = leaf;
+  opt.secondBins = 0;  // one build per row: the table compares bin counts
   opt.threads = threads;
   Bvh bvh;
   double best = 1e30, bestCpu = 1e30;

@@ -479,7 +479,32 @@ void buildSubtree(const BuildContext& ctx, const WorkItem& root, std::vector<gpu
 
 }  // namespace
 
+namespace {
+Bvh buildBvhOnce(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options);
+}  // namespace
+
 Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options) {
+  Bvh bvh = buildBvhOnce(triangles, count, options);
+  // Small meshes: a second build with other bins, kept when its SAH cost is lower (binned SAH splits
+  // greedily top-down, so more bins can make a worse tree: docs/benchmarks.md, "Session 7").
+  if (options.secondBins > 0 && options.secondBins != options.bins && count < options.secondBinsBelow) {
+    BvhBuildOptions o = options;
+    o.bins = options.secondBins;
+    o.secondBins = 0;
+    try {
+      Bvh other = buildBvhOnce(triangles, count, o);
+      if (other.sahCost < bvh.sahCost) bvh = std::move(other);
+    } catch (const Error&) {
+      // Too deep for the traversal stack with these bins: the first tree stands.
+    }
+  }
+  return bvh;
+}
+
+namespace {
+Bvh buildBvhOnce(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options) {
+  if (options.secondBins < 0 || options.secondBins > kMaxBins)
+    throw Error("bvh.cpp: BvhBuildOptions::secondBins must be in [0, " + std::to_string(kMaxBins) + "]");
   if (options.bins < 2 || options.bins > kMaxBins)
     throw Error("bvh.cpp: BvhBuildOptions::bins must be in [2, " + std::to_string(kMaxBins) + "]");
   if (options.maxLeafSize < 1 || options.maxLeafSize > int(gpu::kBvhMaxLeafSize))
@@ -658,6 +683,7 @@ Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions
   for (std::uint32_t i = 0; i < n; ++i) bvh.order[i] = prims[i].index();
   return bvh;
 }
+}  // namespace
 
 Bvh buildBvh(const std::vector<Triangle>& triangles, const BvhBuildOptions& options) {
   return buildBvh(triangles.data(), triangles.size(), options);

@@ -3,6 +3,10 @@
 #include "accel/bvh_wide.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
 #include <string>
 
 #include "accel/ray_box.h"
@@ -45,9 +49,117 @@ gpu::BvhWideNode emptyWideNode() {
 
 bool isInner(std::uint32_t ref) { return (ref & gpu::kBvhLeafBit) == 0; }
 
+// The SAH-optimal collapse (WideCollapseOptions::Method::Sah): over the binary tree, bottom-up (a
+// node's children have larger indices than the node), best[n][j] = the least SAH cost of binary inner
+// node n's subtree when it fills at most j (1..4) slots of its wide parent: one slot as a wide node or
+// (at most maxLeafSize triangles) as one merged leaf, or n opened and its two children sharing the j
+// slots. Costs are surface areas (not divided by the root's) times costNode per wide node,
+// costLeaf + count * costTriangle per leaf. The same idea as Ylitie, Karras, Laine (2017), section 3.
+class SahCollapse {
+ public:
+  SahCollapse(const std::vector<gpu::BvhNode>& b, const WideCollapseOptions& o) : bin_(b), opt_(o) {
+    const std::size_t n = b.size();
+    area_.resize(n);
+    first_.assign(n, 0);
+    count_.assign(n, 0);
+    best_.assign(n, {});
+    split_.assign(n, {});
+    merge_.assign(n, 0);
+    wideSplit_.assign(n, 1);
+    area_[0] = area(glm::min(b[0].lmin, b[0].rmin), glm::max(b[0].lmax, b[0].rmax));
+    for (std::size_t i = 0; i < n; ++i) {  // each inner node's box's area, the box as stored in its parent
+      if (isInner(b[i].left)) check(b[i].left, i), area_[b[i].left] = area(b[i].lmin, b[i].lmax);
+      if (isInner(b[i].right)) check(b[i].right, i), area_[b[i].right] = area(b[i].rmin, b[i].rmax);
+    }
+    for (std::size_t i = n; i-- > 0;) solve(std::uint32_t(i));
+  }
+
+  // The slots of the wide node made from binary inner node n (its children sharing four slots).
+  int slotsOf(std::uint32_t n, Slot out[4]) const {
+    int count = 0;
+    const gpu::BvhNode& b = bin_[n];
+    emit({b.lmin, b.lmax, b.left}, wideSplit_[n], out, count);
+    emit({b.rmin, b.rmax, b.right}, 4 - wideSplit_[n], out, count);
+    return count;
+  }
+
+ private:
+  static float area(const glm::vec3& lo, const glm::vec3& hi) {
+    const glm::vec3 e = hi - lo;
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+  }
+  void check(std::uint32_t child, std::size_t parent) const {
+    if (child >= bin_.size() || child <= parent) throw Error("bvh_wide.cpp: binary child ref out of order (internal error)");
+  }
+  static std::uint32_t leafCount(std::uint32_t ref) { return (ref >> gpu::kBvhCountShift) & 15u; }
+  float leafCost(float a, std::uint32_t count) const { return a * (opt_.costLeaf + opt_.costTriangle * float(count)); }
+  // Least cost of child ref c (box lo..hi) in at most j slots.
+  float childCost(std::uint32_t c, const glm::vec3& lo, const glm::vec3& hi, int j) const {
+    return isInner(c) ? best_[c][j] : leafCost(area(lo, hi), leafCount(c));
+  }
+  void solve(std::uint32_t n) {
+    const gpu::BvhNode& b = bin_[n];
+    // The subtree's triangles: contiguous in leaf order when the two ranges touch.
+    std::uint32_t f[2], c[2];
+    const std::uint32_t refs[2] = {b.left, b.right};
+    for (int k = 0; k < 2; ++k) {
+      if (isInner(refs[k])) f[k] = first_[refs[k]], c[k] = count_[refs[k]];
+      else f[k] = refs[k] & gpu::kBvhFirstMask, c[k] = leafCount(refs[k]);
+    }
+    const bool contiguous = c[0] != 0 && c[1] != 0 && c[0] != ~0u && c[1] != ~0u && f[0] + c[0] == f[1];
+    first_[n] = f[0];
+    count_[n] = contiguous ? c[0] + c[1] : ~0u;  // ~0u: not one range (never for buildBvh's trees)
+    float pair[5];  // pair[j]: both children sharing at most j slots; pairSplit[j]: the left child's share
+    int pairSplit[5] = {1, 1, 1, 1, 1};
+    for (int j = 2; j <= 4; ++j) {
+      pair[j] = std::numeric_limits<float>::infinity();
+      for (int k0 = 1; k0 < j; ++k0) {
+        const float v = childCost(b.left, b.lmin, b.lmax, k0) + childCost(b.right, b.rmin, b.rmax, j - k0);
+        if (v < pair[j]) pair[j] = v, pairSplit[j] = k0;
+      }
+    }
+    wideSplit_[n] = pairSplit[4];
+    const float asWide = area_[n] * opt_.costNode + pair[4];
+    const bool canMerge = contiguous && count_[n] <= std::uint32_t(opt_.maxLeafSize);
+    const float asLeaf = canMerge ? leafCost(area_[n], count_[n]) : std::numeric_limits<float>::infinity();
+    merge_[n] = asLeaf < asWide;
+    best_[n][1] = std::min(asWide, asLeaf);
+    split_[n][1] = 0;
+    for (int j = 2; j <= 4; ++j) {
+      best_[n][j] = best_[n][1];
+      split_[n][j] = 0;
+      if (pair[j] < best_[n][j]) best_[n][j] = pair[j], split_[n][j] = pairSplit[j];
+    }
+  }
+  // Appends child `c` given at most j slots, as solve() chose.
+  void emit(const Slot& c, int j, Slot out[4], int& count) const {
+    if (c.ref == gpu::kBvhEmptyRef) return;
+    if (!isInner(c.ref) || split_[c.ref][j] == 0) {
+      Slot s = c;
+      if (isInner(c.ref) && merge_[c.ref])
+        s.ref = gpu::kBvhLeafBit | count_[c.ref] << gpu::kBvhCountShift | first_[c.ref];
+      out[count++] = s;
+      return;
+    }
+    const gpu::BvhNode& b = bin_[c.ref];
+    const int k0 = split_[c.ref][j];
+    emit({b.lmin, b.lmax, b.left}, k0, out, count);
+    emit({b.rmin, b.rmax, b.right}, j - k0, out, count);
+  }
+
+  const std::vector<gpu::BvhNode>& bin_;
+  const WideCollapseOptions& opt_;
+  std::vector<float> area_;                      // inner node's box's surface area (box as stored in its parent; root: both children's)
+  std::vector<std::uint32_t> first_, count_;     // inner node's triangles (count ~0u: not contiguous)
+  std::vector<std::array<float, 5>> best_;       // [n][j], j = 1..4 (all these: ~40 B per binary node, freed after the collapse)
+  std::vector<std::array<std::uint8_t, 5>> split_;  // [n][j]: left child's share of j slots; 0: n takes one slot
+  std::vector<std::uint8_t> merge_;              // n in one slot: a merged leaf (else a wide node)
+  std::vector<std::uint8_t> wideSplit_;          // n as a wide node: its left child's share of the four slots
+};
+
 }  // namespace
 
-BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
+BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary, const WideCollapseOptions& options) {
   BvhWide out;
   out.nodes.push_back(emptyWideNode());
   out.depth = 1;
@@ -59,6 +171,13 @@ BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
     int stackBefore;           // stack entries the traversal may hold on arriving here
   };
   std::vector<Work> work{{0, 0, 1, 0}};
+  if (options.maxLeafSize < 0 || options.maxLeafSize > int(gpu::kBvhMaxLeafSize))
+    throw Error("bvh_wide.cpp: WideCollapseOptions::maxLeafSize must be in [0, " + std::to_string(gpu::kBvhMaxLeafSize) + "]");
+  // The DP needs a tree without empty slots (a one-leaf or empty tree has them; the greedy keeps those right).
+  std::unique_ptr<SahCollapse> sah;
+  if (options.method == WideCollapseOptions::Method::Sah && binary[0].left != gpu::kBvhEmptyRef &&
+      binary[0].right != gpu::kBvhEmptyRef)
+    sah = std::make_unique<SahCollapse>(binary, options);
   // Every wide node starts from a distinct binary node, so binary.size() bounds the count: reserved
   // once (address space only; untouched pages cost no memory), the vector never reallocates.
   out.nodes.reserve(binary.size());
@@ -80,8 +199,12 @@ BvhWide packBvhWideNodes(const std::vector<gpu::BvhNode>& binary) {
         ++count;
       }
     };
-    addChildren(w.binaryNode, 0);
-    while (count < 4) {
+    if (sah) {
+      count = sah->slotsOf(w.binaryNode, kids);
+    } else {
+      addChildren(w.binaryNode, 0);
+    }
+    while (!sah && count < 4) {
       int best = -1;
       float bestArea = -1.0f;
       for (int k = 0; k < count; ++k)
@@ -205,6 +328,40 @@ Hit traceClosest(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<g
 bool traceOccluded(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriGeom>& tris, const Ray& ray,
                    float tmax) {
   return traverseWide<true>(nodes, tris, ray, tmax).found();
+}
+
+BvhShape bvhShapeFromEnv() {
+  const char* env = std::getenv("CAUSTICA_BVH_SHAPE");
+  return parseBvhShape(env ? env : "");
+}
+
+BvhShape parseBvhShape(const std::string& spec) {
+  BvhShape shape;
+  std::stringstream list(spec);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    const std::size_t eq = item.find('=');
+    const std::string key = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    auto number = [&]() {
+      char* end = nullptr;
+      const double v = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end != '\0') throw Error("CAUSTICA_BVH_SHAPE: bad value in '" + item + "'");
+      return v;
+    };
+    if (key == "collapse" && (value == "greedy" || value == "sah"))
+      shape.collapse.method = value == "sah" ? WideCollapseOptions::Method::Sah : WideCollapseOptions::Method::Greedy;
+    else if (key == "wideleaf") shape.collapse.maxLeafSize = int(number());
+    else if (key == "cn") shape.collapse.costNode = float(number());
+    else if (key == "cl") shape.collapse.costLeaf = float(number());
+    else if (key == "ct") shape.collapse.costTriangle = float(number());
+    else if (key == "leaf") shape.build.maxLeafSize = int(number());
+    else if (key == "bct") shape.build.costTraversal = float(number());
+    else if (key == "bci") shape.build.costIntersect = float(number());
+    else if (key == "bins") shape.build.bins = int(number());
+    else if (key == "bins2") shape.build.secondBins = int(number());
+    else throw Error("CAUSTICA_BVH_SHAPE: unknown item '" + item + "'");
+  }
+  return shape;
 }
 
 }  // namespace caustica

@@ -58,7 +58,8 @@ int cmdInfo(const std::vector<std::string>& args) {
   Bvh bvh;
   InstancedBvh ibvh;
   if (instanced) ibvh = buildInstancedBvh(s);
-  else bvh = buildBvh(s.triangles);
+  const BvhShape shape = bvhShapeFromEnv();
+  if (!instanced) bvh = buildBvh(s.triangles, shape.build);
   double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t topNodes = ibvh.topNodeCount, allNodes = ibvh.nodes.size();
   t0 = std::chrono::steady_clock::now();
@@ -113,9 +114,16 @@ int cmdInfo(const std::vector<std::string>& args) {
   } else {
     std::printf("bvh:        %zu nodes (%zu KiB), %d leaves, depth %d, SAH cost %.2f, built in %.1f ms\n", bvh.nodes.size(),
                 bvh.nodes.size() * sizeof(gpu::BvhNode) / 1024, bvh.leafCount, bvh.depth, bvh.sahCost, buildSeconds * 1e3);
-    const BvhWide wide = packBvhWideNodes(bvh.nodes);  // what the flat traversal reads
-    std::printf("bvh 4-wide: %zu nodes (%zu KiB), depth %d, stack need %d\n", wide.nodes.size(),
-                wide.nodes.size() * sizeof(gpu::BvhWideNode) / 1024, wide.depth, wide.stackNeed);
+    const auto tc = std::chrono::steady_clock::now();
+    const BvhWide wide = packBvhWideNodes(bvh.nodes, shape.collapse);  // what the flat traversal reads
+    const double collapseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
+    std::size_t slots = 0, leaves = 0;
+    for (const gpu::BvhWideNode& n : wide.nodes)
+      for (std::uint32_t ref : {n.child[0], n.child[1], n.child[2], n.child[3]})
+        if (ref != gpu::kBvhEmptyRef) ++slots, leaves += (ref & gpu::kBvhLeafBit) != 0;
+    std::printf("bvh 4-wide: %zu nodes (%zu KiB), %.2f children per node, %zu leaves, depth %d, stack need %d, "
+                "collapsed in %.1f ms\n", wide.nodes.size(), wide.nodes.size() * sizeof(gpu::BvhWideNode) / 1024,
+                double(slots) / double(wide.nodes.size()), leaves, wide.depth, wide.stackNeed, collapseSeconds * 1e3);
     bytes.nodes = wide.nodes.size() * sizeof(gpu::BvhWideNode) + sizeof(gpu::BvhNode);  // as the renderer uploads
   }
   std::printf("memory:     %s; %s\n", gpuBytesSummary(bytes, s.triangles.size()).c_str(),

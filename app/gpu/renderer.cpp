@@ -90,7 +90,8 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     t0 = std::chrono::steady_clock::now();
     gpuScene_ = packInstancedScene(scene, ib);
   } else {
-    bvh_ = buildBvh(scene.triangles);
+    const BvhShape shape = bvhShapeFromEnv();
+    bvh_ = buildBvh(scene.triangles, shape.build);
     memTrace("bvh built");
     bvhSeconds_ = load_.bvh = since(t0);
     t0 = std::chrono::steady_clock::now();
@@ -98,7 +99,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     bvh_.nodes.clear();
     gpuScene_ = packScene(scene, bvh_, false);  // TriGeom and TriShade: packed in slices by the upload
     gpuScene_.nodes = std::move(nodes);
-    wideNodes = packBvhWideNodes(gpuScene_.nodes).nodes;
+    wideNodes = packBvhWideNodes(gpuScene_.nodes, shape.collapse).nodes;
     memTrace("wide nodes");
   }
   load_.pack = since(t0);

@@ -85,9 +85,10 @@ std::vector<Triangle> randomSoup(int count, Rng& rng) {
 
 // Wide traversal against brute force (closest: same t, u, v; a different triangle only as a tie) and
 // against the binary twin; any hit against brute force at several tmax. Returns the disagreements.
-int countWideMismatches(const std::vector<Triangle>& tris, const std::vector<Ray>& rays, int* hits) {
-  const Bvh bvh = buildBvh(tris);
-  const BvhWide wide = packBvhWideNodes(bvh.nodes);
+int countWideMismatches(const std::vector<Triangle>& tris, const std::vector<Ray>& rays, int* hits,
+                        const BvhShape& shape = {}) {
+  const Bvh bvh = buildBvh(tris, shape.build);
+  const BvhWide wide = packBvhWideNodes(bvh.nodes, shape.collapse);
   const std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
   int bad = 0, found = 0;
   for (const Ray& ray : rays) {
@@ -162,21 +163,111 @@ void checkStructure(const Bvh& bvh, const BvhWide& wide) {
   CHECK(wide.depth <= bvh.depth);
 }
 
+// Walks a wide tree of any collapse: every triangle 0..triangleCount-1 in exactly one leaf, leaves of
+// 1..maxLeaf triangles, every slot's box containing its subtree's triangles, 2..4 children per node
+// (a one-leaf tree: 1), every node reached once, stack need within the traversal's. Returns the mean
+// number of children per wide node.
+double checkCover(const BvhWide& wide, const std::vector<gpu::TriGeom>& geom, int maxLeaf) {
+  std::vector<int> seen(geom.size(), 0);
+  std::vector<int> reached(wide.nodes.size(), 0);
+  int badBoxes = 0, badLeaves = 0, badCounts = 0, slots = 0;
+  // Returns the subtree's triangle bounds; checks each slot's box against them.
+  struct Walk {
+    const BvhWide& w;
+    const std::vector<gpu::TriGeom>& g;
+    std::vector<int>& seen;
+    std::vector<int>& reached;
+    int maxLeaf;
+    int &badBoxes, &badLeaves, &badCounts, &slots;
+    Bounds node(std::uint32_t index) {
+      Bounds all;
+      REQUIRE(index < w.nodes.size());
+      ++reached[index];
+      const gpu::BvhWideNode& n = w.nodes[index];
+      int used = 0;
+      for (int k = 0; k < 4; ++k) {
+        const std::uint32_t ref = n.child[k];
+        if (ref == gpu::kBvhEmptyRef) continue;
+        ++used;
+        Bounds b;
+        if (ref & gpu::kBvhLeafBit) {
+          const std::uint32_t first = ref & gpu::kBvhFirstMask, count = (ref >> gpu::kBvhCountShift) & 15u;
+          badLeaves += count < 1 || int(count) > maxLeaf;
+          for (std::uint32_t i = first; i < first + count; ++i) {
+            REQUIRE(i < g.size());
+            ++seen[i];
+            b.grow(glm::vec3(g[i].v0)), b.grow(glm::vec3(g[i].v1)), b.grow(glm::vec3(g[i].v2));
+          }
+        } else {
+          b = node(ref);
+        }
+        badBoxes += !(n.minX[k] <= b.min.x && n.minY[k] <= b.min.y && n.minZ[k] <= b.min.z && n.maxX[k] >= b.max.x &&
+                      n.maxY[k] >= b.max.y && n.maxZ[k] >= b.max.z);
+        all.grow(b.min), all.grow(b.max);
+      }
+      slots += used;
+      badCounts += (used < 2 && w.nodes.size() > 1) || used > 4;
+      return all;
+    }
+  } walk{wide, geom, seen, reached, maxLeaf, badBoxes, badLeaves, badCounts, slots};
+  walk.node(0);
+  CHECK(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(seen.size()));  // every triangle exactly once
+  CHECK(std::count(reached.begin(), reached.end(), 1) == std::ptrdiff_t(reached.size()));
+  CHECK(badBoxes == 0);
+  CHECK(badLeaves == 0);
+  CHECK(badCounts == 0);
+  CHECK(wide.stackNeed <= CAUSTICA_BVH_WIDE_STACK);
+  return double(slots) / double(wide.nodes.size());
+}
+
 }  // namespace
+
+TEST_CASE("bvh wide: SAH collapse covers every triangle once, fills the slots, agrees with brute force") {
+  const std::vector<Triangle> bunny = loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+  Rng rng(8);
+  const std::vector<Triangle> soup = randomSoup(2000, rng);
+  const char* specs[] = {"collapse=sah", "collapse=sah,wideleaf=0", "collapse=sah,wideleaf=8,leaf=1",
+                         "collapse=sah,wideleaf=4,leaf=2,cl=1,ct=0.5", "collapse=sah,leaf=8,wideleaf=15"};
+  for (const std::vector<Triangle>* tris : {&bunny, &soup}) {
+    const Bvh greedyBvh = buildBvh(*tris);
+    const BvhWide greedy = packBvhWideNodes(greedyBvh.nodes, parseBvhShape("collapse=greedy").collapse);
+    const double greedyFill = checkCover(greedy, packTriGeom(*tris, greedyBvh), 4);
+    for (const char* spec : specs) {
+      const std::string specName = spec;
+    CAPTURE(specName);
+      const BvhShape shape = parseBvhShape(spec);
+      const Bvh bvh = buildBvh(*tris, shape.build);
+      const BvhWide wide = packBvhWideNodes(bvh.nodes, shape.collapse);
+      const double fill = checkCover(wide, packTriGeom(*tris, bvh), std::max(shape.build.maxLeafSize, shape.collapse.maxLeafSize));
+      MESSAGE(specName << ": " << wide.nodes.size() << " wide nodes, " << fill << " children per node (greedy "
+                   << greedy.nodes.size() << ", " << greedyFill << "), depth " << wide.depth << ", stack need " << wide.stackNeed);
+      if (shape.build.maxLeafSize == 4) CHECK(wide.nodes.size() < greedy.nodes.size());  // the slots are filled better
+      int hits = 0;
+      CHECK(countWideMismatches(*tris, mixedRays(*tris, 3000, rng), &hits, shape) == 0);
+      CHECK(hits > 1000);
+    }
+  }
+}
 
 TEST_CASE("bvh wide: collapse keeps every leaf once, boxes bit for bit, 2-4 children per node") {
   const std::vector<Triangle> bunny = loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
   const Bvh bvh = buildBvh(bunny);
-  const BvhWide wide = packBvhWideNodes(bvh.nodes);
-  checkStructure(bvh, wide);
-  // Each wide node stands for up to three binary inner nodes; near the leaves many stand for one or two.
-  MESSAGE("bunny: " << bvh.nodes.size() << " binary inner nodes, " << wide.nodes.size() << " wide, depth " << bvh.depth
-                    << " -> " << wide.depth << ", stack need " << wide.stackNeed);
-  CHECK(wide.nodes.size() * 5 < bvh.nodes.size() * 3);
   Rng rng(5);
   const std::vector<Triangle> soup = randomSoup(3000, rng);
   const Bvh soupBvh = buildBvh(soup);
-  checkStructure(soupBvh, packBvhWideNodes(soupBvh.nodes));
+  // The greedy collapse, and the SAH one without merged leaves: both keep the binary leaves as they are.
+  for (const char* spec : {"collapse=greedy", "collapse=sah,wideleaf=0"}) {
+    const std::string specName = spec;
+    CAPTURE(specName);
+    const WideCollapseOptions options = parseBvhShape(spec).collapse;
+    const BvhWide wide = packBvhWideNodes(bvh.nodes, options);
+    checkStructure(bvh, wide);
+    // Each wide node stands for up to three binary inner nodes; near the leaves many stand for one or two.
+    MESSAGE(specName << ": bunny: " << bvh.nodes.size() << " binary inner nodes, " << wide.nodes.size() << " wide, depth "
+                 << bvh.depth << " -> " << wide.depth << ", stack need " << wide.stackNeed);
+    CHECK(wide.nodes.size() * 5 < bvh.nodes.size() * 3);
+    checkStructure(soupBvh, packBvhWideNodes(soupBvh.nodes, options));
+  }
 }
 
 TEST_CASE("bvh wide: agrees with brute force and the binary twin (bunny, random soup with degenerates)") {

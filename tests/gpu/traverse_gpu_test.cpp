@@ -39,8 +39,8 @@ std::vector<Triangle> randomSoup(int n, std::mt19937& g) {
 
 // Traces rays (two vec4 each: origin and tmax, direction) with glsl/tests/trace_test.comp: per ray
 // (t, u, v, tri bits) of traceClosest and 1/0 of traceOccluded.
-void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std::vector<glm::vec4>& rays,
-                std::vector<glm::vec4>& hits, std::vector<std::uint32_t>& occ) {
+void traceOnGpu(const Bvh& bvh, const std::vector<gpu::BvhWideNode>& wide, const std::vector<gpu::TriGeom>& geom,
+                const std::vector<glm::vec4>& rays, std::vector<glm::vec4>& hits, std::vector<std::uint32_t>& occ) {
   const int rayCount = static_cast<int>(rays.size() / 2);
   GlBuffer nodes = GlBuffer::fromVector(bvh.nodes);
   GlBuffer geomBuf = GlBuffer::fromVector(geom);
@@ -51,8 +51,7 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std
   ExpandedShader src = lib.expand("tests/trace_test.comp", {});
   GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
   prog.use();
-  BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test",
-                       packBvhWideNodes(bvh.nodes).nodes);
+  BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test", wide);
   textures.bind();
   geomBuf.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_TRIGEOM);
   rayBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 8);
@@ -68,8 +67,11 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::TriGeom>& geom, const std
   occBuf.read(0, occ.size() * sizeof(std::uint32_t), occ.data());
 }
 
-void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::uint32_t seed) {
-  Bvh bvh = buildBvh(tris);
+// `shape`: the tree's build and collapse (parseBvhShape syntax; "" = the defaults).
+void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::uint32_t seed, const std::string& shapeSpec = "") {
+  const BvhShape shape = parseBvhShape(shapeSpec);
+  Bvh bvh = buildBvh(tris, shape.build);
+  const std::vector<gpu::BvhWideNode> wide = packBvhWideNodes(bvh.nodes, shape.collapse).nodes;
   std::vector<gpu::TriGeom> geom = packTriGeom(tris, bvh);
   Bounds b;
   for (const auto& t : tris)
@@ -94,9 +96,8 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
   }
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
-  traceOnGpu(bvh, geom, rays, hits, occ);
+  traceOnGpu(bvh, wide, geom, rays, hits, occ);
 
-  const std::vector<gpu::BvhWideNode> wide = packBvhWideNodes(bvh.nodes).nodes;
   int mismatches = 0, hitCount = 0;
   for (int i = 0; i < rayCount; ++i) {
     Hit h = traceClosest(wide, geom, cpuRays[i], tmaxes[i]);
@@ -118,6 +119,12 @@ void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::ui
 
 TEST_CASE("GPU traversal equals the C++ twin: bunny") {
   compareGpuWithTwin(loadObjTriangles(test::sourcePath("assets/meshes/bunny.obj")), 20000, 1);
+}
+
+TEST_CASE("GPU traversal equals the C++ twin: bunny, greedy collapse and merged leaves of up to 8 triangles") {
+  const std::vector<Triangle> bunny = loadObjTriangles(test::sourcePath("assets/meshes/bunny.obj"));
+  compareGpuWithTwin(bunny, 8000, 4, "collapse=greedy");
+  compareGpuWithTwin(bunny, 8000, 5, "collapse=sah,leaf=1,wideleaf=8,cl=16");
 }
 
 TEST_CASE("GPU traversal equals the C++ twin: random soup with a degenerate triangle") {
@@ -178,8 +185,8 @@ TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never e
   }
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
-  traceOnGpu(bvh, geom, rays, hits, occ);
   const BvhWide wide = packBvhWideNodes(bvh.nodes);
+  traceOnGpu(bvh, wide.nodes, geom, rays, hits, occ);
   int gpuEscapes = 0, cpuEscapes = 0, gpuOccMisses = 0;
   for (int k = 0; k < rayCount; ++k) {
     gpuEscapes += glm::floatBitsToUint(hits[k].w) == gpu::kInvalidIndex;
@@ -288,7 +295,7 @@ TEST_CASE("reintersect on the GPU: rays spawned from hits on 1,000 triangles (1e
     }
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
-  traceOnGpu(bvh, geom, rays, hits, occ);
+  traceOnGpu(bvh, packBvhWideNodes(bvh.nodes).nodes, geom, rays, hits, occ);
   int selfHits = 0;
   for (size_t r = 0; r < hits.size(); ++r) selfHits += glm::floatBitsToUint(hits[r].w) == leafOf[r / perTriangle];
   CHECK(selfHits == 0);
