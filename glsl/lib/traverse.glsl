@@ -241,15 +241,18 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
   uint ref = 0u;  // the root, an inner node
   while (true) {
     // Inner nodes until this lane holds a leaf (or the empty leaf: see BVH_INNER_STEP).
-    while ((ref & kBvhLeafBit) == 0u) {
+    // Both loops test at the bottom: on llvmpipe a top-tested loop runs one masked body more than its
+    // trip count when its last lane leaves (docs/architecture.md, llvmpipe note; session 7: 1.15-1.24x).
+    if ((ref & kBvhLeafBit) == 0u) do {
       uvec4 r;
       vec4 t;
       uint hits = bvhVisitWide(ref, org, invDir, hit.t, r, t);
       BVH_INNER_STEP
-    }
+    } while ((ref & kBvhLeafBit) == 0u);
     uint first = ref & kBvhFirstMask;
     uint count = (ref >> kBvhCountShift) & 15u;
-    for (uint i = first; i < first + count; ++i) {
+    uint i = first;
+    if (count > 0u) do {
       vec3 p0, p1, p2;
       bvhTriangle(i, p0, p1, p2);
       float t, u, v;
@@ -259,7 +262,7 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
         hit.v = v;
         hit.tri = i;
       }
-    }
+    } while (++i < first + count);
     BVH_OUTER_STEP
   }
   return hit.tri != kInvalidIndex;
@@ -276,15 +279,16 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
   BVH_STACK_VARS
   uint ref = 0u;
   while (true) {
-    while ((ref & kBvhLeafBit) == 0u) {
+    if ((ref & kBvhLeafBit) == 0u) do {
       uvec4 r;
       vec4 t;
       uint hits = bvhVisitWide(ref, org, invDir, tmax, r, t);
       BVH_INNER_STEP
-    }
+    } while ((ref & kBvhLeafBit) == 0u);
     uint first = ref & kBvhFirstMask;
     uint count = (ref >> kBvhCountShift) & 15u;
-    for (uint i = first; i < first + count; ++i) {
+    uint i = first;
+    if (count > 0u) do {
       vec3 p0, p1, p2;
       uint material = bvhTriangle(i, p0, p1, p2);
       float t, u, v;
@@ -293,7 +297,7 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
 #else
       if (intersectTriangleSheared(org, rs, p0, p1, p2, tmax, t, u, v)) return true;
 #endif
-    }
+    } while (++i < first + count);
     BVH_OUTER_STEP
   }
   return false;

@@ -231,8 +231,8 @@ TEST_CASE("GPU traversal: zero-area triangles are never hit (packed as one point
     }
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
-  traceOnGpu(bvh, geom, rays, hits, occ);
   const BvhWide wide = packBvhWideNodes(bvh.nodes);
+  traceOnGpu(bvh, wide.nodes, geom, rays, hits, occ);
   int gpuHits = 0, gpuOccluded = 0, cpuHits = 0;
   for (std::size_t k = 0; k < cpu.size(); ++k) {
     gpuHits += glm::floatBitsToUint(hits[k].w) != gpu::kInvalidIndex;
