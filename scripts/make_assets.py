@@ -865,6 +865,29 @@ def sun_glass():
     return g.finish()
 
 
+def mirror_caustic():
+    """A white floor under a small warm lamp, and a standing mirror beside it that throws the lamp's
+    reflection onto the floor: a reflection caustic (found only by bouncing off the mirror) next to a
+    floor that direct-light sampling makes smooth at once. Its noise is uneven: the bench scene of
+    adaptive sampling (docs/benchmarks.md, "Adaptive sampling"). Open to a black sky, no walls."""
+    g = Gltf()
+    white = g.material("floor", color=(0.8, 0.8, 0.8))
+    mirror = g.material("mirror", color=(0.95, 0.95, 0.95), metallic=1.0, roughness=0.0, double_sided=True)
+    floor = MeshData()
+    floor.polygon([(-4, 0, -4), (4, 0, -4), (4, 0, 4), (-4, 0, 4)], (0, 1, 0))
+    g.object("floor", floor, white)
+    # 1.0 m wide, 0.8 m tall, in the plane x = 0.8 facing the lamp (-x); reflects on both sides.
+    panel = MeshData()
+    panel.polygon([(0.8, 0, -0.5), (0.8, 0, 0.5), (0.8, 0.8, 0.5), (0.8, 0.8, -0.5)], (-1, 0, 0))
+    g.object("mirror", panel, mirror)
+    # A 0.25 m square lamp 1.8 m up, facing down; its mirror image lights the floor at x > -0.3.
+    lamp = g.material("lamp", color=(0.78, 0.78, 0.78), emissive=(1.0, 0.95, 0.85), strength=150.0)
+    g.object("lamp", ceiling_light(0.25, 0.25, x=-0.6, y=1.8), lamp)
+    eye, target = (-0.3, 2.4, 2.4), (0.2, 0.0, -0.3)
+    g.camera("camera", position=eye, yfov=0.8, rotation=quat_look(sub(target, eye)))
+    return g.finish()
+
+
 # ---- bad inputs ------------------------------------------------------------------------------------
 def triangle_doc(positions=None, indices=(0, 1, 2), mode=None, extra_accessor_count=None):
     """A minimal valid one-triangle scene, returned as a dict to be broken by the caller."""
@@ -1073,6 +1096,7 @@ def main():
         os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
         os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
         os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),
+        os.path.join(SCENES, "mirror-caustic.gltf"): mirror_caustic(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),
