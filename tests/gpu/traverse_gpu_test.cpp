@@ -67,6 +67,15 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::BvhWideNode>& wide, const
   occBuf.read(0, occ.size() * sizeof(std::uint32_t), occ.data());
 }
 
+// One ray for both sides, from `origin` towards `target` with no tmax: appended to the GPU list (two
+// vec4: origin and tmax, direction) and to the C++ twin's.
+void addRay(std::vector<glm::vec4>& rays, std::vector<Ray>& cpu, glm::vec3 origin, glm::vec3 target) {
+  const Ray r{origin, glm::normalize(target - origin)};
+  cpu.push_back(r);
+  rays.push_back(glm::vec4(r.origin, 1e30f));
+  rays.push_back(glm::vec4(r.dir, 0.0f));
+}
+
 // `shape`: the tree's build and collapse (parseBvhShape syntax; "" = the defaults).
 void compareGpuWithTwin(const std::vector<Triangle>& tris, int rayCount, std::uint32_t seed, const std::string& shapeSpec = "") {
   const BvhShape shape = parseBvhShape(shapeSpec);
@@ -178,10 +187,7 @@ TEST_CASE("watertight: 100,000 rays from inside a closed jittered sphere never e
     if (k % 3 == 0) target = v[t[k % 3 == 0 ? (k / 3) % 3 : 0]];               // a vertex, exactly
     else if (k % 3 == 1) target = glm::mix(v[t[0]], v[t[1]], u(g));            // a point on an edge
     else target = 2.0f * glm::normalize(glm::vec3(u(g) - 0.5f, u(g) - 0.5f, u(g) - 0.5f) + 1e-6f);  // anywhere
-    Ray r{o, glm::normalize(target - o)};
-    cpu.push_back(r);
-    rays.push_back(glm::vec4(o, 1e30f));
-    rays.push_back(glm::vec4(r.dir, 0.0f));
+    addRay(rays, cpu, o, target);
   }
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
@@ -224,10 +230,7 @@ TEST_CASE("GPU traversal: zero-area triangles are never hit (packed as one point
     for (int k = 0; k < 50; ++k) {
       const glm::vec3 target = glm::mix(t.p[0], t.p[2], float(k % 11) / 10.0f);
       const glm::vec3 o = target + 2.0f * glm::normalize(glm::vec3(u(g), u(g), u(g)) + 1e-6f);
-      Ray r{o, glm::normalize(target - o)};
-      cpu.push_back(r);
-      rays.push_back(glm::vec4(o, 1e30f));
-      rays.push_back(glm::vec4(r.dir, 0.0f));
+      addRay(rays, cpu, o, target);
     }
   std::vector<glm::vec4> hits;
   std::vector<std::uint32_t> occ;
