@@ -880,7 +880,9 @@ def mirror_caustic():
     panel = MeshData()
     panel.polygon([(0.8, 0, -0.5), (0.8, 0, 0.5), (0.8, 0.8, 0.5), (0.8, 0.8, -0.5)], (-1, 0, 0))
     g.object("mirror", panel, mirror)
-    # A 0.25 m square lamp 1.8 m up, facing down; its mirror image lights the floor at x > -0.3.
+    # A 0.25 m square lamp 1.8 m up, facing down. Its mirror image (x = 2.2) lights the floor from x ~ -0.3
+    # (rays past the mirror's top edge; the lamp's size blurs it over -0.42..-0.22) to the mirror's foot at
+    # x = 0.8, |z| up to 0.5 there and ~0.9 at the far edge; behind the mirror lies its shadow.
     lamp = g.material("lamp", color=(0.78, 0.78, 0.78), emissive=(1.0, 0.95, 0.85), strength=150.0)
     g.object("lamp", ceiling_light(0.25, 0.25, x=-0.6, y=1.8), lamp)
     eye, target = (-0.3, 2.4, 2.4), (0.2, 0.0, -0.3)

@@ -129,7 +129,7 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
 // single runs are printed). Measured offline (llvmpipe, 8 seeds, 4096-spp reference; ratios at 8 /
 // 32 / 128 / 512 spp): cornell-glass 1.59 / 0.96 / 1.03 / 0.96, cornell-dispersion 1.18 / 1.20 /
 // 1.10 / 1.12, cornell-box 1.04 / 1.10 / 1.08. This test (2048-spp reference, 8 seeds; at 128 / 256 /
-// 512 spp): every scene 0.94-1.23, the closest punctual-lights 1.23 / 1.23 / 1.13 and many-lights
+// 512 spp): every scene 0.92-1.23, the closest punctual-lights 1.23 / 1.23 / 1.13 and many-lights
 // 1.17 / 1.13 / 1.16 (with 4 seeds punctual-lights read 1.37 at 256 spp and failed: its error is
 // firefly-heavy, single runs 0.82-1.77), cornell-dispersion 1.16 / 0.94 / 1.12. Below ~128 spp a caustic scene's 4-seed average moves
 // by +-40 % (cornell-dispersion at 32 spp: 1.49 for seeds 1-4, 1.04 for seeds 5-8) and the estimate
@@ -285,10 +285,11 @@ TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
   }
 }
 
-// The bundled scene of uneven noise (assets/scenes/mirror-caustic.gltf): the floor patch that only the
-// lamp's reflection in the mirror lights has ~100x the per-sample variance of the directly lit floor,
-// so the sampler must give its tiles several times the samples of the quiet floor (n ~ sqrt(v), capped
-// at 8x by the ratio guard). 64x64, target relMSE 0.02, the median spp of the tiles wholly inside the
+// The bundled scene of uneven noise (assets/scenes/mirror-caustic.gltf): the floor patch that the lamp's
+// reflection in the mirror also lights (light only a bounce off the mirror finds) has ~2000x the
+// per-sample relative variance of the directly lit floor (4x4-tile medians 9.5-10.9 against 0.005), so
+// the sampler must give its tiles several times the samples of the quiet floor (n ~ sqrt(v) would be
+// ~45x; the ratio guard caps it at 8x). 64x64, target relMSE 0.02, the median spp of the tiles wholly inside the
 // scene's caustic crop (bench/scenes.json) against that of the tiles wholly outside it. Measured
 // (llvmpipe, seeds 7-10): 5.7, 5.8, 5.1, 5.8 (spp 40-60 .. 347-390, mean 134-144); uniform sampling
 // gives 1.0, so a sampler that stopped following the noise fails.
