@@ -5,15 +5,14 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include "cli/bench/bench_metrics.h"
 #include "gl_test_util.h"
 #include "gpu/adaptive_sampler.h"
 #include "scene/assets.h"
 #include "scene/environment.h"
-#include "util/file_io.h"
 
 using namespace caustica;
 using namespace caustica::test;
@@ -295,7 +294,7 @@ TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
 // gives 1.0, so a sampler that stopped following the noise fails.
 TEST_CASE("adaptive sampling: on mirror-caustic the samples go to the mirror's caustic patch") {
   const Scene scene = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
-  const auto info = parseBenchScenes(readFileText(sourcePath("bench/scenes.json")), "bench/scenes.json");
+  const auto info = readBenchScenes(sourcePath("bench/scenes.json"));
   REQUIRE(info.at("mirror-caustic").caustic);
   RenderSettings rs;
   rs.width = 64;

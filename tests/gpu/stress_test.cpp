@@ -65,10 +65,6 @@ Region regionMean(const Image& img, const PixelRect& r) {
   return out;
 }
 
-std::map<std::string, BenchSceneInfo> benchScenes() {
-  return parseBenchScenes(readFileText(sourcePath("bench/scenes.json")), "bench/scenes.json");
-}
-
 }  // namespace
 
 // Same seed, same sample indices: a transformed scene that renders the same image follows the same
@@ -81,7 +77,7 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
   const std::vector<std::pair<std::string, std::pair<double, double>>> transforms = {
       {"scale1e-4", {1e-4, 0.0}}, {"scale1e-2", {1e-2, 0.0}}, {"scale1e2", {1e2, 0.0}}, {"scale1e4", {1e4, 0.0}},
       {"move1e3", {1.0, 1e3}},    {"move1e4", {1.0, 1e4}},    {"move1e5", {1.0, 1e5}}};
-  const auto info = benchScenes();
+  const auto info = readBenchScenes(sourcePath("bench/scenes.json"));
   const int spp = 16;
   double worst = 0.0;  // largest relative deviation of any region
   std::string worstAt;

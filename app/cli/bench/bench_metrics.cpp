@@ -13,6 +13,7 @@
 
 #include "image/error_estimate.h"
 #include "util/error.h"
+#include "util/file_io.h"
 
 namespace caustica {
 
@@ -252,6 +253,10 @@ std::map<std::string, BenchSceneInfo> parseBenchScenes(const std::string& jsonTe
     out[name] = info;
   }
   return out;
+}
+
+std::map<std::string, BenchSceneInfo> readBenchScenes(const std::string& path) {
+  return parseBenchScenes(readFileText(path), path);
 }
 
 std::string benchCsvHeader() {

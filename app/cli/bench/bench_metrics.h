@@ -107,6 +107,8 @@ struct BenchSceneInfo {
 // ("note" and "reference_spp" optional; N even, >= 2).
 // `fileName` names the file in error messages. Throws Error on bad JSON or bad rectangles.
 std::map<std::string, BenchSceneInfo> parseBenchScenes(const std::string& jsonText, const std::string& fileName);
+// The same, read from the file at `path` (named in errors; Error when it cannot be read).
+std::map<std::string, BenchSceneInfo> readBenchScenes(const std::string& path);
 
 // One checkpoint of one run: a row of the CSV.
 struct BenchRow {

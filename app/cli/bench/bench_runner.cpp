@@ -20,7 +20,6 @@
 #include "platform/context.h"
 #include "scene/assets.h"
 #include "util/error.h"
-#include "util/file_io.h"
 
 namespace caustica::cli {
 
@@ -78,7 +77,7 @@ class BenchRunner {
       dispersions_.push_back(parseDispersionMode(name));
     if (dispersions_.empty()) throw Error("option --dispersion needs at least one of rgb, spectral");
     std::string scenesJson = findScenesJson(opts);
-    if (!scenesJson.empty()) sceneInfo_ = parseBenchScenes(readFileText(scenesJson), scenesJson);
+    if (!scenesJson.empty()) sceneInfo_ = readBenchScenes(scenesJson);
     else note(quiet_, "warning: bench/scenes.json not found: no caustic regions (use --scenes-json FILE)");
     std::error_code ec;
     fs::create_directories(outDir_, ec);

@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <random>
 #include <sstream>
 
@@ -13,6 +12,7 @@
 #include "cli/bench/bench_metrics.h"
 #include "image/error_estimate.h"
 #include "util/error.h"
+#include "util/file_io.h"
 
 using namespace caustica;
 
@@ -42,13 +42,6 @@ std::vector<std::string> splitCsv(const std::string& line) {
     }
   }
   return out;
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
 }
 
 }  // namespace
@@ -238,7 +231,7 @@ TEST_CASE("scenes.json: caustic crops are validated") {
 TEST_CASE("bench/scenes.json covers every bundled scene and marks the glass caustic") {
   std::string path = std::string(CAUSTICA_SOURCE_DIR) + "/bench/scenes.json";
   REQUIRE(std::filesystem::exists(path));
-  auto m = parseBenchScenes(readText(path), path);
+  auto m = readBenchScenes(path);
   for (const auto& name : assetSceneNames()) CHECK_MESSAGE(m.count(name) == 1, name);
   REQUIRE(m.count("cornell-glass") == 1);
   CHECK(m["cornell-glass"].caustic.has_value());
@@ -277,7 +270,7 @@ TEST_CASE("CSV rows have one field per header column, quoted where needed") {
 
   std::string path = (std::filesystem::temp_directory_path() / "caustica_bench_metrics_test.csv").string();
   writeBenchCsv(path, {r, r});
-  std::istringstream text(readText(path));
+  std::istringstream text(readFileText(path));
   std::string line;
   int lines = 0;
   while (std::getline(text, line)) ++lines;
