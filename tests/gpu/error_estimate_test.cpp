@@ -291,7 +291,9 @@ TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
 // ~45x; the ratio guard caps it at 8x). 64x64, target relMSE 0.02, the median spp of the tiles wholly inside the
 // scene's caustic crop (bench/scenes.json) against that of the tiles wholly outside it. Measured
 // (llvmpipe, seeds 7-10): 5.7, 5.8, 5.1, 5.8 (spp 40-60 .. 347-390, mean 134-144); uniform sampling
-// gives 1.0, so a sampler that stopped following the noise fails.
+// gives 1.0, a ratio guard of 2x about 2. Held to 4: with the patch ~10 % of the frame and ~2000x noisier,
+// the allocation's expected gain falls from ~3.7 at a ratio of 5.5 to ~3.0 at 4 (~2.5 at 3), so an
+// allocation that loses a fifth of the gain fails.
 TEST_CASE("adaptive sampling: on mirror-caustic the samples go to the mirror's caustic patch") {
   const Scene scene = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
   const auto info = readBenchScenes(sourcePath("bench/scenes.json"));
@@ -332,7 +334,7 @@ TEST_CASE("adaptive sampling: on mirror-caustic the samples go to the mirror's c
                                         << e.sppMax << " (mean " << e.sppMean << "); median spp of the caustic's tiles "
                                         << mIn << " (" << in.size() << " tiles), of the rest " << mOut << " ("
                                         << out.size() << "), ratio " << mIn / mOut);
-  CHECK(mIn >= 3.0 * mOut);
+  CHECK(mIn >= 4.0 * mOut);
 }
 
 // The all-features shader (--all-features, docs/benchmarks.md "Specialisation") renders the image of
