@@ -2,6 +2,7 @@
 // CPU), Mtris/s, SAH cost, node/leaf counts and depth, and single-thread traceClosest Mrays/s, for the
 // bunny and a generated displaced sphere of about 1M triangles, over a few (bins, maxLeafSize, threads) choices.
 #include <cmath>
+#include "scene/assets.h"
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
     };
     std::vector<Mesh> meshes;
     if (onlyMesh.empty() || onlyMesh == "bunny")
-      meshes.push_back({"bunny", loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj"), 200000, 5});
+      meshes.push_back({"bunny", loadObjTriangles(sourceDir() + "/assets/meshes/bunny.obj"), 200000, 5});
     if (onlyMesh.empty() || onlyMesh == "sphere1M") meshes.push_back({"sphere1M", displacedSphere(1024, 512), 100000, 3});
     if (onlyMesh == "sphere4M") meshes.push_back({"sphere4M", displacedSphere(2048, 1024), 100000, 3});
     if (meshes.empty()) throw Error("--mesh must be bunny, sphere1M or sphere4M");

@@ -19,6 +19,8 @@ std::string executableDir() {
 }
 }  // namespace
 
+std::string sourceDir() { return CAUSTICA_SOURCE_DIR; }
+
 std::string assetSceneDir() {
   std::vector<fs::path> candidates;
   if (const char* env = std::getenv("CAUSTICA_ASSETS")) candidates.emplace_back(fs::path(env) / "scenes");

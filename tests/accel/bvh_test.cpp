@@ -1,6 +1,7 @@
 // bvh_test.cpp — tests of the watertight ray–triangle test, the binned-SAH BVH builder (structural
 // invariants, depth bound on adversarial input) and the C++ traversal against brute force.
 #include <doctest/doctest.h>
+#include "scene/assets.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +26,7 @@ const float kInf = std::numeric_limits<float>::infinity();
 
 
 std::vector<Triangle> loadBunny() {
-  return loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+  return loadObjTriangles(sourceDir() + "/assets/meshes/bunny.obj");
 }
 
 struct Rng {

@@ -1,6 +1,7 @@
 // bvh_wide_test.cpp — the 4-wide BVH collapsed from the binary tree (structure: every binary leaf once,
 // boxes bit for bit, stack bound) and its C++ traversal twin against brute force and the binary twin.
 #include <doctest/doctest.h>
+#include "scene/assets.h"
 
 #include <algorithm>
 #include <cmath>
@@ -223,7 +224,7 @@ double checkCover(const BvhWide& wide, const std::vector<gpu::TriGeom>& geom, in
 }  // namespace
 
 TEST_CASE("bvh wide: SAH collapse covers every triangle once, fills the slots, agrees with brute force") {
-  const std::vector<Triangle> bunny = loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+  const std::vector<Triangle> bunny = loadObjTriangles(sourceDir() + "/assets/meshes/bunny.obj");
   Rng rng(8);
   const std::vector<Triangle> soup = randomSoup(2000, rng);
   const char* specs[] = {"collapse=sah", "collapse=sah,wideleaf=0", "collapse=sah,wideleaf=8,leaf=1",
@@ -250,7 +251,7 @@ TEST_CASE("bvh wide: SAH collapse covers every triangle once, fills the slots, a
 }
 
 TEST_CASE("bvh wide: collapse keeps every leaf once, boxes bit for bit, 2-4 children per node") {
-  const std::vector<Triangle> bunny = loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+  const std::vector<Triangle> bunny = loadObjTriangles(sourceDir() + "/assets/meshes/bunny.obj");
   const Bvh bvh = buildBvh(bunny);
   Rng rng(5);
   const std::vector<Triangle> soup = randomSoup(3000, rng);
@@ -271,7 +272,7 @@ TEST_CASE("bvh wide: collapse keeps every leaf once, boxes bit for bit, 2-4 chil
 }
 
 TEST_CASE("bvh wide: agrees with brute force and the binary twin (bunny, random soup with degenerates)") {
-  const std::vector<Triangle> bunny = loadObjTriangles(std::string(CAUSTICA_SOURCE_DIR) + "/assets/meshes/bunny.obj");
+  const std::vector<Triangle> bunny = loadObjTriangles(sourceDir() + "/assets/meshes/bunny.obj");
   Rng rng(6);
   int hits = 0;
   CHECK(countWideMismatches(bunny, mixedRays(bunny, 12000, rng), &hits) == 0);

@@ -2,6 +2,7 @@
 // get the linear image back, and per-region statistics.
 #pragma once
 #include <doctest/doctest.h>
+#include "scene/assets.h"
 
 #include <algorithm>
 #include <array>
@@ -21,7 +22,7 @@ namespace caustica::test {
 
 extern std::string gGlDescription;
 
-inline std::string sourcePath(const std::string& rel) { return std::string(CAUSTICA_SOURCE_DIR) + "/" + rel; }
+inline std::string sourcePath(const std::string& rel) { return sourceDir() + "/" + rel; }
 
 struct RenderResult {
   Image image;

@@ -2,6 +2,7 @@
 // accessor formats, the material contract, cameras, textures, and that bad input only ever throws
 // caustica::Error with a one-line message naming the file.
 #include <doctest/doctest.h>
+#include "scene/assets.h"
 
 #include <cmath>
 #include <cstdint>
@@ -28,7 +29,7 @@ namespace fs = std::filesystem;
 
 constexpr int kByte = 5121, kShort = 5123, kUint = 5125, kFloat = 5126;
 
-std::string source(const std::string& relative) { return std::string(CAUSTICA_SOURCE_DIR) + "/" + relative; }
+std::string source(const std::string& relative) { return caustica::sourceDir() + "/" + relative; }
 
 // A fresh directory under the system temp dir, removed at the end of the test.
 struct TempDir {

@@ -49,7 +49,7 @@ std::string findScenesJson(const Options& opts) {
   if (opts.has("--scenes-json")) return opts.get("--scenes-json", "");
   std::vector<fs::path> candidates = {fs::path(assetSceneDir()) / ".." / ".." / "bench" / "scenes.json",
                                       fs::path(assetSceneDir()) / ".." / "bench" / "scenes.json",
-                                      fs::path(CAUSTICA_SOURCE_DIR) / "bench" / "scenes.json"};
+                                      fs::path(sourceDir()) / "bench" / "scenes.json"};
   for (const auto& c : candidates) {
     std::error_code ec;
     if (fs::is_regular_file(c, ec)) return fs::weakly_canonical(c, ec).string();

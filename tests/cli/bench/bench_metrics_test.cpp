@@ -229,7 +229,7 @@ TEST_CASE("scenes.json: caustic crops are validated") {
 }
 
 TEST_CASE("bench/scenes.json covers every bundled scene and marks the glass caustic") {
-  std::string path = std::string(CAUSTICA_SOURCE_DIR) + "/bench/scenes.json";
+  std::string path = sourceDir() + "/bench/scenes.json";
   REQUIRE(std::filesystem::exists(path));
   auto m = readBenchScenes(path);
   for (const auto& name : assetSceneNames()) CHECK_MESSAGE(m.count(name) == 1, name);
