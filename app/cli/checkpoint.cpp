@@ -17,24 +17,6 @@
 
 namespace caustica::cli {
 
-std::string checkpointSettingsText(const RenderSettings& s, int cameraIndex, const Camera& c) {
-  std::ostringstream t;
-  t << std::setprecision(9);
-  t << "size " << s.width << 'x' << s.height << '\n'
-    << "seed " << s.seed << '\n'
-    << "max-depth " << s.maxDepth << '\n'
-    << "integrator " << integratorName(s.integrator) << '\n'
-    << "dispersion " << dispersionModeName(s.dispersion) << '\n'
-    << "caster-probability " << s.casterProbability << '\n';
-  // Only other modes say theirs, so checkpoints written before modes existed still resume.
-  if (s.mode != RenderMode::Path) t << "mode " << renderModeName(s.mode) << '\n';
-  t << "camera " << cameraIndex << '\n'
-    << "camera-view " << c.position.x << ' ' << c.position.y << ' ' << c.position.z << ' ' << c.forward.x << ' '
-    << c.forward.y << ' ' << c.forward.z << ' ' << c.up.x << ' ' << c.up.y << ' ' << c.up.z << ' ' << c.yfov << ' '
-    << c.aspect << '\n';
-  return t.str();
-}
-
 namespace {
 
 std::uint64_t dataHash(const AccumulationState& st) {
@@ -72,8 +54,8 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     << "seed " << ck.seed << '\n'
     << "scene " << hex64(ck.sceneHash) << '\n'
     << "data " << hex64(dataHash(st)) << '\n'
-    << "settings " << ck.settingsText.size() << '\n'
-    << ck.settingsText << "end\n";
+    << "settings " << ck.identity.size() << '\n'
+    << ck.identity << "end\n";
   const std::string header = h.str();
   writeFileAtomically(path, ".tmp", [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -110,9 +92,13 @@ Checkpoint readCheckpoint(const std::string& path) {
   };
   const unsigned long long version = num(kCheckpointMagic);
   if (version < kCheckpointOldestVersion || version > kCheckpointVersion)
-    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads versions " +
-              std::to_string(kCheckpointOldestVersion) + " to " + std::to_string(kCheckpointVersion) + ")");
-  const bool coverage = version >= 3 && num("coverage") != 0;  // version 2: opaque renders only
+    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads version " +
+              std::to_string(kCheckpointVersion) +
+              (version < kCheckpointOldestVersion ? ", whose settings name every option that changes the image; "
+                                                    "render again to write one"
+                                                  : "") +
+              ")");
+  const bool coverage = num("coverage") != 0;
   Checkpoint ck;
   AccumulationState& st = ck.state;
   unsigned long long w = num("width"), hgt = num("height"), settingsBytes = num("settings");
@@ -127,7 +113,7 @@ Checkpoint readCheckpoint(const std::string& path) {
   ck.sceneHash = num("scene");
   const std::uint64_t expected = num("data");
   if (settingsLineEnd + 1 + settingsBytes != end + 1) throw bad("settings text of the wrong length");
-  ck.settingsText = bytes.substr(settingsLineEnd + 1, settingsBytes);
+  ck.identity = bytes.substr(settingsLineEnd + 1, settingsBytes);
   const size_t dataAt = end + 5;
   const size_t n = static_cast<size_t>(w) * hgt * 4;
   const size_t dataBytes = (3 * n + (coverage ? n / 4 : 0)) * sizeof(float);
@@ -148,20 +134,11 @@ Checkpoint readCheckpoint(const std::string& path) {
   return ck;
 }
 
-std::string checkpointMismatch(const Checkpoint& ck, std::uint64_t sceneHash, const std::string& settingsText) {
-  std::vector<std::string> diffs;
-  std::map<std::string, std::string> a = parseLines(ck.settingsText), b = parseLines(settingsText);
-  for (const auto& [key, value] : b) {
-    auto it = a.find(key);
-    std::string saved = it == a.end() ? "(none)" : it->second;
-    if (saved != value) diffs.push_back(key + ": checkpoint " + saved + ", this render " + value);
-  }
-  for (const auto& [key, value] : a)
-    if (!b.count(key)) diffs.push_back(key + ": checkpoint " + value + ", this render (none)");
+std::string checkpointMismatch(const Checkpoint& ck, std::uint64_t sceneHash, const std::string& identity) {
+  std::string out = identityDifference(ck.identity, identity, "checkpoint", "this render");
   if (ck.sceneHash != sceneHash)
-    diffs.push_back("scene files differ (checkpoint " + hex64(ck.sceneHash) + ", this scene " + hex64(sceneHash) + ")");
-  std::string out;
-  for (const auto& d : diffs) out += (out.empty() ? "" : "; ") + d;
+    out += (out.empty() ? "" : "; ") + std::string("scene files differ (checkpoint ") + hex64(ck.sceneHash) +
+           ", this scene " + hex64(sceneHash) + ")";
   return out;
 }
 

@@ -1,10 +1,17 @@
 // checkpoint.h — the checkpoint file of a long render (`render --checkpoint`, `--resume`): the running
-// sums, sample counters, seed, scene fingerprint and image-changing settings. Format and I/O only, no GL.
+// sums, sample counters, seed, scene fingerprint and accumulation identity. Format and I/O only, no GL.
+//
+// Whether two sets of samples may be added together is decided by two values, and only these:
+// hashSceneFiles(scene path) (cli/bench/reference_cache.h) and accumulationIdentity(settings, camera)
+// (cli/image_settings.h), derived from the one field list of ImageSettings, so that an option added
+// there is part of it without further code. Anything else that adds samples together (render --shard,
+// merge) should store and compare these two the same way: checkpointMismatch below, or
+// identityDifference for the settings alone.
 #pragma once
 #include <cstdint>
 #include <string>
 
-#include "gpu/render_settings.h"
+#include "cli/image_settings.h"
 #include "gpu/renderer.h"
 #include "scene/scene.h"
 
@@ -13,20 +20,18 @@ namespace caustica::cli {
 constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
 // 2: adds the odd-sample half image (error estimate, adaptive sampling); version 1 files are refused.
 // 3: adds a "coverage 0|1" header line and, with 1, the r32f coverage image after the three others
-// (--background transparent); version 2 files still load (no coverage: opaque renders).
-constexpr int kCheckpointVersion = 3;
-constexpr int kCheckpointOldestVersion = 2;
+// (--background transparent).
+// 4: the settings text is the accumulation identity (every Accumulation field of ImageSettings, one
+// "key value" a line); older files are refused, naming the file: their settings text lacks fields.
+constexpr int kCheckpointVersion = 4;
+constexpr int kCheckpointOldestVersion = 4;
 
 struct Checkpoint {
   AccumulationState state;        // the three rgba32f images (+ coverage), spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
-  std::string settingsText;       // checkpointSettingsText(...)
+  std::string identity;           // accumulationIdentity(settings, camera) of the render
 };
-
-// The settings that change the image, one "key value" a line (size, seed, max-depth, integrator,
-// dispersion, caster-probability, camera): two renders may share samples only if these are equal.
-std::string checkpointSettingsText(const RenderSettings& settings, int cameraIndex, const Camera& camera);
 
 // Writes `path` atomically: a temporary file in the same folder (path + ".tmp"), fsync, rename. An
 // interrupted write leaves the previous checkpoint intact. Throws Error naming the file on failure.
@@ -35,8 +40,8 @@ void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint);
 // it is not a checkpoint, truncated or corrupted.
 Checkpoint readCheckpoint(const std::string& path);
 
-// "" when `checkpoint` belongs to this scene and these settings; otherwise what differs, e.g.
+// "" when `checkpoint` belongs to this scene and this identity; otherwise what differs, e.g.
 // "seed: checkpoint 1, this render 2; scene files differ (checkpoint 0123..., this scene 4567...)".
-std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t sceneHash, const std::string& settingsText);
+std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t sceneHash, const std::string& identity);
 
 }  // namespace caustica::cli

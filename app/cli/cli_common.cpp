@@ -292,22 +292,13 @@ void note(bool quiet, const std::string& line) {
 
 int cameraIndexFrom(const Options& opts) { return opts.getInt("--camera", 0, 0, 1 << 20); }
 
-LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose) {
+LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose, int defaultWidth) {
   const LoadOptions loadOptions = loadOptionsFrom(opts);  // option errors before any file is read
   std::string path = resolveScenePath(nameOrPath);
   LoadedScene ls;
   ls.scene = loadScene(path, loadOptions);
   releaseFreedMemory();  // the parser's arrays and the file's bytes: freed heap back to the kernel (memory_stats.h)
   for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
-  if (opts.has("--light-radius")) {
-    const double r = opts.getDouble("--light-radius", 0.0);
-    if (!(r > 0.0) || r > 3.0e38) throw Error("option --light-radius needs a positive number of scene units");
-    const std::size_t before = ls.scene.punctualLights.size();
-    applyLightRadius(ls.scene, static_cast<float>(r));
-    note(!verbose, "--light-radius: " + std::to_string(before - ls.scene.punctualLights.size()) +
-                       " point/spot light(s) made emissive spheres of radius " + opts.get("--light-radius", ""));
-  }
-  applyEnvironmentOptions(opts, ls.scene, verbose);  // environment_options.cpp
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {
     if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");
@@ -318,6 +309,8 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
                   std::to_string(ls.scene.cameras.size()) + " camera(s)");
     ls.camera = ls.scene.cameras[static_cast<size_t>(index)];
   }
+  ls.settings = imageSettingsFrom(opts, ls.camera, defaultWidth);
+  applySceneSettings(ls.settings, ls.scene, verbose);
   return ls;
 }
 
@@ -334,31 +327,9 @@ void flattenForRaster(Scene& scene, const Options& opts, bool quiet) {
   flattenInstances(scene);
 }
 
-LoadedScene loadSceneForCli(const Options& opts, bool verbose) {
+LoadedScene loadSceneForCli(const Options& opts, bool verbose, int defaultWidth) {
   if (opts.positional().size() > 1) throw Error("expected one scene, got " + std::to_string(opts.positional().size()));
-  return loadSceneForCli(opts.positional().empty() ? kDefaultScene : opts.positional()[0], opts, verbose);
-}
-
-RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
-  const RenderSettings defaults;
-  RenderSettings s;
-  parseSize(opts.get("--size", std::to_string(defaultWidth)), camera.aspect, s.width, s.height);
-  s.seed = static_cast<std::uint32_t>(opts.getInt("--seed", static_cast<int>(defaults.seed), 0, 2147483647));
-  s.maxDepth = opts.getInt("--max-depth", defaults.maxDepth, kMinMaxDepth, kMaxMaxDepth);
-  if (!opts.isList("--integrator")) s.integrator = parseIntegrator(opts.get("--integrator", integratorName(defaults.integrator)));
-  if (!opts.isList("--dispersion"))
-    s.dispersion = parseDispersionMode(opts.get("--dispersion", dispersionModeName(defaults.dispersion)));
-  if (!opts.isList("--mode")) s.mode = parseRenderMode(opts.get("--mode", renderModeName(defaults.mode)));
-  s.casterProbability = static_cast<float>(opts.getDouble("--caster-probability", defaults.casterProbability));
-  if (!(s.casterProbability >= 0.0f && s.casterProbability <= kMaxCasterProbability)) {
-    std::ostringstream m;
-    m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
-    throw Error(m.str());
-  }
-  s.allFeatures = opts.has("--all-features");
-  s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
-  s.validate();
-  return s;
+  return loadSceneForCli(opts.positional().empty() ? kDefaultScene : opts.positional()[0], opts, verbose, defaultWidth);
 }
 
 ShaderLibrary shaderLibraryFrom(const Options& opts) { return ShaderLibrary(opts.get("--shader-dir", "")); }

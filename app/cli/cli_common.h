@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/image_settings.h"
 #include "platform/gl_context.h"
 #include "gpu/renderer.h"
 #include "scene/scene.h"
@@ -60,24 +61,23 @@ LoadOptions loadOptionsFrom(const Options& opts);
 void parseSize(const std::string& text, float cameraAspect, int& width, int& height);
 
 struct LoadedScene {
-  Scene scene;
-  Camera camera;
+  Scene scene;              // with the settings' scene side applied (applySceneSettings)
+  Camera camera;            // the camera settings.camera picked
+  ImageSettings settings;   // everything that decides the image (cli/image_settings.h)
 };
-// Loads `nameOrPath` (a bundled scene name or a file), prints its warnings when verbose, and picks
-// --camera N (default 0; a camera framing the scene if it has none).
-LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose);
+// The one path from the command line to a scene ready to render (render, view, bench, compare,
+// info): loads `nameOrPath` (a bundled scene name or a file), prints its warnings when verbose, picks
+// --camera N (default 0; a camera framing the scene if it has none), reads every image setting
+// (imageSettingsFrom; --size defaults to `defaultWidth` pixels wide) and applies their scene side
+// (applySceneSettings: --light-radius, --env..., --background).
+LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose, int defaultWidth = 512);
 // The same for the command's one positional scene argument (default: the bundled default scene).
-LoadedScene loadSceneForCli(const Options& opts, bool verbose);
+LoadedScene loadSceneForCli(const Options& opts, bool verbose, int defaultWidth = 512);
 int cameraIndexFrom(const Options& opts);  // --camera N, default 0
 // The raster mode draws flat scenes only: bakes an instanced scene's instances on the host
 // (flattenInstances), or refuses (Error) when that would exceed --max-triangles.
 void flattenForRaster(Scene& scene, const Options& opts, bool quiet);
 
-// The one place the command line becomes RenderSettings (render, view and bench): --size (default
-// `defaultWidth`, height from the camera's aspect), --seed, --max-depth, --integrator, --dispersion,
-// --caster-probability, each checked with an error that names the option. An option the command
-// declares as a LIST (bench) is left at its default: the command sets it per run.
-RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth);
 ShaderLibrary shaderLibraryFrom(const Options& opts);
 
 // Renders until `renderer` holds `targetSpp` samples per pixel. Passes grow while they take under

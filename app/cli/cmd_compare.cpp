@@ -40,15 +40,13 @@ int cmdCompare(const std::vector<std::string>& args) {
   const int spp = opts.getInt("--spp", 64, 1, 1 << 24);
   const int whittedSpp = opts.getInt("--whitted-spp", 4, 1, 4096);
   const std::string panelsPrefix = opts.get("--save-panels", "");
-  ToneMapSettings tone;
-  tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", 0.0));
-  tone.curve = parseToneCurve(opts.get("--tonemap", "aces"));
   Backend backend = parseBackend(opts.get("--backend", "auto"));
   checkWritableFile(out, "output");
 
-  LoadedScene ls = loadSceneForCli(opts, !quiet);
+  LoadedScene ls = loadSceneForCli(opts, !quiet, 384);
   flattenForRaster(ls.scene, opts, quiet);  // one scene for the three modes; raster draws flat ones
-  RenderSettings settings = renderSettingsFrom(opts, ls.camera, 384);
+  RenderSettings settings = ls.settings.render;
+  const ToneMapSettings& tone = ls.settings.tone;
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);
   note(quiet, "OpenGL (" + context->backendName() + "): " + glInfo);

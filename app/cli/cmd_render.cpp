@@ -62,9 +62,6 @@ int cmdRender(const std::vector<std::string>& args) {
   budget.maxSpp = spp;
   const std::string statsFile = opts.get("--stats", "");
   if (opts.has("--stats")) checkWritableFile(statsFile, "stats");
-  ToneMapSettings tone;
-  tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", 0.0));
-  tone.curve = parseToneCurve(opts.get("--tonemap", "aces"));
   Backend backend = parseBackend(opts.get("--backend", "auto"));
   const double checkpointSeconds = opts.getDouble("--checkpoint", 0.0);
   if (opts.has("--checkpoint") && !(checkpointSeconds > 0.0))
@@ -78,20 +75,19 @@ int cmdRender(const std::vector<std::string>& args) {
 
   memTrace("command start");
   const auto commandStart = std::chrono::steady_clock::now();
-  LoadedScene ls = loadSceneForCli(opts, !quiet);
+  LoadedScene ls = loadSceneForCli(opts, !quiet, 512);  // the scene with every image setting applied
   memTrace("scene loaded");
   const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
-  RenderSettings settings = renderSettingsFrom(opts, ls.camera, 512);
+  const RenderSettings& settings = ls.settings.render;
+  const ToneMapSettings& tone = ls.settings.tone;
   if (settings.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, quiet);  // cli_common.h
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
-  std::string settingsText = checkpointSettingsText(settings, cameraIndexFrom(opts), ls.camera);
-  if (opts.has("--light-radius")) settingsText += "light-radius " + opts.get("--light-radius", "") + "\n";  // changes the scene
-  settingsText += "environment " + ls.scene.environment.describe() + "\nbackground " + ls.scene.background.describe() +
-                  "\n";  // --env, --background change the image
+  const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
+  note(quiet, "settings: " + settingsSummary(ls.settings));
   if (resumeFrom) {
-    std::string diff = checkpointMismatch(*resumeFrom, sceneHash, settingsText);
+    std::string diff = checkpointMismatch(*resumeFrom, sceneHash, identity);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
   }
   std::string glInfo;
@@ -116,7 +112,7 @@ int cmdRender(const std::vector<std::string>& args) {
     ck.state = renderer.saveAccumulation();
     ck.seed = settings.seed;
     ck.sceneHash = sceneHash;
-    ck.settingsText = settingsText;
+    ck.identity = identity;
     writeCheckpoint(checkpointFile, ck);
   };
   ProgressHooks hooks;

@@ -51,8 +51,6 @@ int cmdView(const std::vector<std::string>& args) {
   config.vsync = !opts.has("--no-vsync");
   config.preview = !opts.has("--no-preview");
   config.spinRadians = opts.getDouble("--spin", 0.0) * 3.14159265358979 / 180.0;
-  config.tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", 0.0));
-  config.tone.curve = parseToneCurve(opts.get("--tonemap", "aces"));
   config.fixedSize = opts.has("--size");
   Viewer viewer(opts, config);
   return viewer.run();

@@ -10,7 +10,7 @@ std::vector<OptionSpec> environmentOptionSpecs() {
   return {
       {"--env", "", "FILE|RGB|none",
        "environment light: an equirectangular .hdr/.exr map, a uniform sky (0.8 or R,G,B) or none "
-       "(default: none if the scene has emitters, else a uniform sky of radiance 1)"},
+       "(default auto: none if the scene has emitters, else a uniform sky of radiance 1)"},
       {"--env-strength", "", "S", "multiplies the environment's radiance (default 1)"},
       {"--env-rotation", "", "DEG", "turns the environment map about +Y, right-handed (default 0)"},
       {"--background", "", "WHAT",
@@ -22,40 +22,38 @@ std::vector<OptionSpec> environmentOptionSpecs() {
 namespace {
 // The raster and Whitted modes light with the emitters only (docs/render-modes.md): say so when
 // the environment is all the light there is.
-void noteModeWithoutEnvironment(const Options& opts, const Scene& scene, bool verbose) {
-  const std::string mode = opts.get("--mode", "path");
-  if (mode != "path" && scene.environment.emits())
-    note(!verbose, "warning: the image will be black: --mode " + mode + " does not see the environment yet and " +
-                       scene.path + " has no emitters (use --mode path)");
+void noteModeWithoutEnvironment(RenderMode mode, const Scene& scene, bool verbose) {
+  if (mode != RenderMode::Path && scene.environment.emits())
+    note(!verbose, std::string("warning: the image will be black: --mode ") + renderModeName(mode) +
+                       " does not see the environment yet and " + scene.path + " has no emitters (use --mode path)");
 }
 }  // namespace
 
-void applyEnvironmentOptions(const Options& opts, Scene& scene, bool verbose) {
-  const float strength = static_cast<float>(opts.getDouble("--env-strength", 1.0));
-  const float rotation = static_cast<float>(opts.getDouble("--env-rotation", 0.0));
-  if (!(strength >= 0.0f)) throw Error("option --env-strength needs a non-negative number");
-  scene.background = parseBackground(opts.get("--background", "env"));
-  if (scene.background.kind == Background::Kind::Transparent && opts.get("--mode", "path") == "raster")
+void applyEnvironmentSettings(const ImageSettings& settings, Scene& scene, bool verbose) {
+  const SceneSettings& s = settings.scene;
+  const RenderMode mode = settings.render.mode;
+  scene.background = parseBackground(s.background);
+  if (scene.background.kind == Background::Kind::Transparent && mode == RenderMode::Raster)
     note(!verbose, "warning: --mode raster draws an opaque image: --background transparent needs --mode path or whitted");
   scene.environment = Environment{};
   const bool emitters = sceneHasLights(scene);  // emissive triangles (the environment is not set yet)
-  if (opts.has("--env")) {
-    scene.environment = parseEnvironment(opts.get("--env", "none"), strength, rotation);
+  if (s.env != "auto") {
+    scene.environment = parseEnvironment(s.env, s.envStrength, s.envRotation);
     if (!emitters && !scene.environment.emits())
       note(!verbose, "warning: the image will be black: " + scene.path +
                          " has no emitters (emissive triangles or punctual lights) and the environment emits nothing (--env " +
-                         opts.get("--env", "") + ")");
+                         s.env + ")");
     else if (!emitters)
-      noteModeWithoutEnvironment(opts, scene, verbose);
+      noteModeWithoutEnvironment(mode, scene, verbose);
     return;
   }
   if (emitters) return;
-  scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance), strength);
-  scene.environment.rotationDegrees = rotation;
+  scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance), s.envStrength);
+  scene.environment.rotationDegrees = s.envRotation;
   scene.environment.isDefault = true;
   note(!verbose, scene.path + " has no emitters (emissive triangles or punctual lights): lit by the default environment, a uniform sky of radiance 1 "
                               "(--env FILE|RGB to choose one, --env none for none)");
-  noteModeWithoutEnvironment(opts, scene, verbose);
+  noteModeWithoutEnvironment(mode, scene, verbose);
 }
 
 std::string lightingSummary(const Scene& scene, std::size_t emitterTriangles) {

@@ -1,7 +1,9 @@
 // render_settings.cpp — parsing, validation and comparison of RenderSettings.
 #include "gpu/render_settings.h"
 
+#include <iomanip>
 #include <sstream>
+#include <vector>
 
 #include "util/error.h"
 
@@ -49,10 +51,29 @@ void RenderSettings::validate() const {
 }
 
 bool RenderSettings::operator==(const RenderSettings& o) const {
-  return width == o.width && height == o.height && seed == o.seed && maxDepth == o.maxDepth &&
-         integrator == o.integrator && dispersion == o.dispersion && casterProbability == o.casterProbability &&
-         mode == o.mode && allFeatures == o.allFeatures && samplesPerDispatch == o.samplesPerDispatch;
+  // Field by field through the one list (visitFields), in the same order for both sides.
+  std::vector<std::string> mine, theirs;
+  visitFields(*this, [&](const char*, SettingRole, const auto& v) { mine.push_back(settingText(v)); });
+  visitFields(o, [&](const char*, SettingRole, const auto& v) { theirs.push_back(settingText(v)); });
+  return mine == theirs;
 }
+
+const char* settingRoleName(SettingRole r) {
+  return r == SettingRole::Accumulation ? "accumulation" : r == SettingRole::Speed ? "speed" : "output";
+}
+
+std::string settingText(int v) { return std::to_string(v); }
+std::string settingText(std::uint32_t v) { return std::to_string(v); }
+std::string settingText(float v) {
+  std::ostringstream t;
+  t << std::setprecision(9) << v;
+  return t.str();
+}
+std::string settingText(bool v) { return v ? "on" : "off"; }
+std::string settingText(const std::string& v) { return v; }
+std::string settingText(Integrator v) { return integratorName(v); }
+std::string settingText(DispersionMode v) { return dispersionModeName(v); }
+std::string settingText(RenderMode v) { return renderModeName(v); }
 
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to) {
   SettingsChange c;

@@ -1,8 +1,12 @@
 // render_settings.h — the one value that says how to render (size, seed, depth, estimator, dispersion,
-// caster aiming): parsed once by every command, validated here, applied by Renderer::apply. No GL.
+// caster aiming): parsed once by every command, validated here, applied by Renderer::apply; its fields
+// listed once (visitFields) for comparison, the checkpoint identity and printing. No GL.
 #pragma once
 #include <cstdint>
 #include <string>
+#include <type_traits>
+
+#include "util/field_count.h"
 
 namespace caustica {
 
@@ -51,6 +55,56 @@ struct RenderSettings {
   bool operator==(const RenderSettings& o) const;
   bool operator!=(const RenderSettings& o) const { return !(*this == o); }
 };
+
+// What a setting changes, for visitFields' users (docs/long-renders.md, "What must match"):
+enum class SettingRole {
+  // The samples themselves (their expectation or their random streams): part of the accumulation
+  // identity, which two renders must share to add their samples (resume, shards, merge).
+  Accumulation,
+  // Only how fast the same samples are made: left out of the identity. Each such field says whether
+  // the samples stay the same bit for bit or to float rounding.
+  Speed,
+  // Only how the accumulated sums are written out (tone curve, exposure): left out of the identity.
+  Output,
+};
+const char* settingRoleName(SettingRole r);  // "accumulation" | "speed" | "output"
+
+// Calls visit(name, role, field) for every field of `s` (a RenderSettings, const or not), in one fixed
+// order. `name` is the field's key in the checkpoint identity and in printed settings (the option
+// without "--", or "width"/"height" for --size). operator==, the checkpoint identity
+// (cli/image_settings.h) and printing all go through it, so a field is either everywhere or nowhere;
+// the static_assert below fails the build when a field is added without a line here, and
+// tests/cli/image_settings_test.cpp checks that every visited field changes what its role says.
+template <class Settings, class Visit,
+          std::enable_if_t<std::is_same_v<std::remove_const_t<Settings>, RenderSettings>, int> = 0>
+void visitFields(Settings& s, Visit&& visit) {
+  visit("width", SettingRole::Accumulation, s.width);
+  visit("height", SettingRole::Accumulation, s.height);
+  visit("seed", SettingRole::Accumulation, s.seed);
+  visit("max-depth", SettingRole::Accumulation, s.maxDepth);
+  visit("integrator", SettingRole::Accumulation, s.integrator);
+  visit("dispersion", SettingRole::Accumulation, s.dispersion);
+  visit("caster-probability", SettingRole::Accumulation, s.casterProbability);
+  visit("mode", SettingRole::Accumulation, s.mode);
+  // The same expected image; the same bits on llvmpipe (tests/gpu/error_estimate_test.cpp), to float
+  // rounding elsewhere.
+  visit("all-features", SettingRole::Speed, s.allFeatures);
+  // The same bits for every K (tests/gpu/regen_test.cpp).
+  visit("samples-per-dispatch", SettingRole::Speed, s.samplesPerDispatch);
+}
+// Added a field to RenderSettings? Add it to visitFields above (with its role), then count it here.
+static_assert(fieldCount<RenderSettings>() == 10, "RenderSettings has a field that visitFields does not list");
+
+// A setting's value as one word of text, the same in the checkpoint identity and printed settings
+// (floats with 9 significant digits, so two floats with the same text are the same float).
+std::string settingText(int v);
+std::string settingText(std::uint32_t v);
+std::string settingText(float v);
+std::string settingText(bool v);  // "on" | "off"
+std::string settingText(const std::string& v);
+std::string settingText(Integrator v);
+std::string settingText(DispersionMode v);
+std::string settingText(RenderMode v);
 
 // What changing the settings from `from` to `to` asks of a renderer. Every change restarts
 // accumulation; some also need new images, another shader variant or new caster parameters.

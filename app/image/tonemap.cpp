@@ -13,6 +13,8 @@ ToneCurve parseToneCurve(const std::string& name) {
   throw Error("unknown tone curve '" + name + "' (expected clamp or aces)");
 }
 
+const char* toneCurveName(ToneCurve curve) { return curve == ToneCurve::Clamp ? "clamp" : "aces"; }
+
 glm::vec3 tonemapCurve(const glm::vec3& x, ToneCurve curve) {
   if (curve == ToneCurve::Aces)
     return glm::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);

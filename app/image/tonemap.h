@@ -17,6 +17,7 @@ struct ToneMapSettings {
 };
 
 ToneCurve parseToneCurve(const std::string& name);  // "clamp" | "aces"; throws Error otherwise
+const char* toneCurveName(ToneCurve curve);
 glm::vec3 tonemapCurve(const glm::vec3& x, ToneCurve curve);
 glm::vec3 linearToSrgb(const glm::vec3& c);
 // Linear RGB floats (w*h*3) to 8-bit sRGB RGB bytes.

@@ -1,5 +1,6 @@
 # checkpoint_resume.cmake — render 8 spp with --checkpoint, resume to 16 spp and compare with a straight
-# 16-spp render bit for bit; resuming with another seed or another scene must fail naming what differs
+# 16-spp render bit for bit (also with other speed and output settings); resuming with another seed,
+# size, background, environment, light radius or scene must fail naming what differs
 # (run with cmake -P; CLI, COMPARE (viewer_image_compare) and DIR given).
 file(REMOVE_RECURSE ${DIR})
 file(MAKE_DIRECTORY ${DIR})
@@ -20,6 +21,14 @@ if(NOT crc EQUAL 0 OR NOT a STREQUAL b)
   message(FATAL_ERROR "the resumed render differs from the straight one: ${cout}")
 endif()
 
+# Speed and output settings are not part of the accumulation identity (cli/image_settings.h): a resume
+# with another --samples-per-dispatch and --exposure goes on, to the same bits.
+run(0 ${COMMON} --spp 16 --samples-per-dispatch 1 --exposure 1 -o ${DIR}/resumed2.exr --resume ${DIR}/half.exr.ckpt)
+file(SHA256 ${DIR}/resumed2.exr c)
+if(NOT c STREQUAL b)
+  message(FATAL_ERROR "a resume with another --samples-per-dispatch and --exposure differs from the straight render")
+endif()
+
 # Each refused resume exits 1 naming what differs.
 function(refused pattern)
   run(1 ${ARGN})
@@ -31,7 +40,14 @@ refused("half.exr.ckpt: cannot resume another render: seed: checkpoint 1, this r
         ${COMMON} --spp 16 --seed 2 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
 refused("cannot resume another render: .*scene files differ"
         cornell-glass --size 16 --backend osmesa -q --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
-refused("size: checkpoint 16x16, this render 8x8" ${COMMON} --size 8 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
+refused("height: checkpoint 16, this render 8; .*width: checkpoint 16, this render 8" ${COMMON} --size 8 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
+# The settings that change the scene are part of it too.
+refused("background: checkpoint env, this render 0.2,0.2,0.2"
+        ${COMMON} --background 0.2,0.2,0.2 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
+refused("env: checkpoint auto, this render 0.5; env-strength: checkpoint 1, this render 2"
+        ${COMMON} --env 0.5 --env-strength 2 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
+refused("light-radius: checkpoint 0, this render 0.0500000007"
+        ${COMMON} --light-radius 0.05 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
 if(EXISTS ${DIR}/x.exr)
   message(FATAL_ERROR "a refused resume wrote an image")
 endif()

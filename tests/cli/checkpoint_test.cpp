@@ -29,11 +29,11 @@ Checkpoint sample(int w, int h, float base) {
   }
   ck.seed = 7;
   ck.sceneHash = 0x0123456789abcdefull;
-  RenderSettings rs;
-  rs.width = w;
-  rs.height = h;
-  rs.seed = 7;
-  ck.settingsText = checkpointSettingsText(rs, 0, Camera{});
+  ImageSettings is;
+  is.render.width = w;
+  is.render.height = h;
+  is.render.seed = 7;
+  ck.identity = accumulationIdentity(is, Camera{});
   return ck;
 }
 
@@ -66,16 +66,16 @@ TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
   CHECK(b.state.sampleBase == 8u);
   CHECK(b.seed == 7u);
   CHECK(b.sceneHash == 0x0123456789abcdefull);
-  CHECK(b.settingsText == a.settingsText);
+  CHECK(b.identity == a.identity);
   CHECK(b.state.accum == a.state.accum);
   CHECK(b.state.comp == a.state.comp);
   CHECK(b.state.half == a.state.half);
   CHECK(b.state.coverage.empty());  // an opaque render has no coverage image
-  CHECK(slurp(path).rfind("CAUSTICA-CKPT 3\n", 0) == 0);
-  CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.settingsText).empty());
+  CHECK(slurp(path).rfind("CAUSTICA-CKPT 4\n", 0) == 0);
+  CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.identity).empty());
 }
 
-TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; version 2 files still load") {
+TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; older versions are refused") {
   std::string path = tempPath("coverage.ckpt");
   Checkpoint a = sample(3, 2, 1.5f);
   for (int i = 0; i < 6; ++i) a.state.coverage.push_back(float(i % 3) * 4.0f);
@@ -92,15 +92,17 @@ TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; v
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
   spit(path, bytes.substr(0, bytes.size() - 6 * sizeof(float)));
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("truncated"), Error);
-  // A version-2 file (written before coverage existed: no coverage line, three images) loads as opaque.
+  // A version-3 file (its settings text named only some of the image's settings) is refused, naming
+  // the file and what to do.
   writeCheckpoint(path, sample(3, 2, 1.5f));
-  std::string v2 = slurp(path);
-  v2.replace(0, std::string("CAUSTICA-CKPT 3").size(), "CAUSTICA-CKPT 2");
-  v2.erase(v2.find("coverage 0\n"), std::string("coverage 0\n").size());
-  spit(path, v2);
-  Checkpoint old = readCheckpoint(path);
-  CHECK(old.state.coverage.empty());
-  CHECK(old.state.half == a.state.half);
+  std::string v3 = slurp(path);
+  v3.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 3");
+  spit(path, v3);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path),
+                       doctest::Contains("coverage.ckpt: not a usable caustica checkpoint: version 3 (this caustica "
+                                         "reads version 4, whose settings name every option that changes the image; "
+                                         "render again to write one)"),
+                       Error);
 }
 
 TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with the file's name") {
@@ -117,9 +119,13 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
   // A version-1 file (no half image: no error estimate to resume adaptive sampling from) is refused.
   std::string v1 = good;
-  v1.replace(0, std::string("CAUSTICA-CKPT 3").size(), "CAUSTICA-CKPT 1");
+  v1.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 1");
   spit(path, v1);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 2 to 3)"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads version 4"), Error);
+  std::string v5 = good;
+  v5.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 5");
+  spit(path, v5);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 5 (this caustica reads version 4)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);
@@ -127,21 +133,25 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
 
 TEST_CASE("checkpoint: the mismatch names each differing setting and the scene") {
   Checkpoint ck = sample(2, 2, 0.0f);
-  RenderSettings rs;
-  rs.width = 2;
-  rs.height = 2;
-  rs.seed = 9;
-  rs.maxDepth = 12;
-  std::string diff = checkpointMismatch(ck, 42, checkpointSettingsText(rs, 0, Camera{}));
+  ImageSettings is;
+  is.render.width = 2;
+  is.render.height = 2;
+  is.render.seed = 9;
+  is.render.maxDepth = 12;
+  is.scene.env = "sun-sky";
+  std::string diff = checkpointMismatch(ck, 42, accumulationIdentity(is, Camera{}));
   CHECK(diff.find("seed: checkpoint 7, this render 9") != std::string::npos);
   CHECK(diff.find("max-depth: checkpoint 256, this render 12") != std::string::npos);
+  CHECK(diff.find("env: checkpoint auto, this render sun-sky") != std::string::npos);
   CHECK(diff.find("scene files differ") != std::string::npos);
-  CHECK(diff.find("size") == std::string::npos);
+  CHECK(diff.find("width") == std::string::npos);
   Camera moved;
   moved.position.x = 0.5f;
-  rs.seed = 7;
-  rs.maxDepth = 256;
-  std::string camDiff = checkpointMismatch(ck, ck.sceneHash, checkpointSettingsText(rs, 1, moved));
+  is.render.seed = 7;
+  is.render.maxDepth = 256;
+  is.scene.env = "auto";
+  is.camera = 1;
+  std::string camDiff = checkpointMismatch(ck, ck.sceneHash, accumulationIdentity(is, moved));
   CHECK(camDiff.find("camera: checkpoint 0, this render 1") != std::string::npos);
   CHECK(camDiff.find("camera-view: checkpoint 0 ") != std::string::npos);
 }

@@ -37,7 +37,7 @@ TEST_CASE("resume from a checkpoint: 8 spp + 8 spp equals 16 spp bit for bit") {
     CHECK(ck.state.spp == 8);
     CHECK(ck.state.sampleBase == 8u);
     ck.seed = rs.seed;
-    ck.settingsText = cli::checkpointSettingsText(rs, 0, camera);
+    ck.identity = cli::accumulationIdentity(cli::ImageSettings{rs}, camera);
     cli::writeCheckpoint(path, ck);
   }
   Renderer resumed(library, scene, camera, rs);

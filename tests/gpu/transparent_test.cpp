@@ -216,7 +216,7 @@ TEST_CASE("transparent background: a checkpoint keeps the coverage: 8 + 8 spp eq
     cli::Checkpoint ck;
     ck.state = first.saveAccumulation();
     CHECK(ck.state.coverage.size() == static_cast<size_t>(kSize) * kSize);
-    ck.settingsText = cli::checkpointSettingsText(rs, 0, frontCamera());
+    ck.identity = cli::accumulationIdentity(cli::ImageSettings{rs}, frontCamera());
     cli::writeCheckpoint(path, ck);
   }
   Renderer second(library, scene, frontCamera(), rs);

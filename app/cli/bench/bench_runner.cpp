@@ -110,10 +110,10 @@ class BenchRunner {
  private:
   void benchScene(const ShaderLibrary& library, const ReferenceCache& cache, const std::string& path) {
     const std::string name = fs::path(path).stem().string();
-    LoadedScene ls = loadSceneForCli(path, opts_, !quiet_);
+    LoadedScene ls = loadSceneForCli(path, opts_, !quiet_, 256);
     ReferenceRequest request;
-    request.cameraIndex = cameraIndexFrom(opts_);
-    const RenderSettings settings = renderSettingsFrom(opts_, ls.camera, 256);
+    request.cameraIndex = ls.settings.camera;
+    const RenderSettings settings = ls.settings.render;
     request.scenePath = path;
     request.sceneName = name;
     request.measured = settings;

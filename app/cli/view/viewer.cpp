@@ -37,13 +37,13 @@ std::string format(const char* fmt, double a) {
 
 Viewer::Viewer(const Options& opts, const ViewConfig& config)
     : config_(config), pacer_(PacingConfig{config.budgetMs, config.maxSpp, config.preview, config.frameLimit > 0}) {
-  scene_ = loadSceneForCli(opts, !config_.quiet);
+  scene_ = loadSceneForCli(opts, !config_.quiet, kDefaultWidth);  // every image setting, the scene's applied
   sceneName_ = fileStem(scene_.scene.path);
-  RenderSettings settings = renderSettingsFrom(opts, scene_.camera, kDefaultWidth);
+  RenderSettings settings = scene_.settings.render;
   if (settings.mode == RenderMode::Raster) flattenForRaster(scene_.scene, opts, config_.quiet);
   controls_.rasterAllowed = scene_.scene.instances.empty();  // M skips raster for an instanced scene
   controls_.wanted = settings;
-  controls_.tone = config_.tone;
+  controls_.tone = scene_.settings.tone;
   controls_.stopAtTarget = config_.targetError > 0.0;
   if (config_.targetError > 0.0) controls_.targetError = config_.targetError;
   input_ = ViewerInput(controls_, config_.spinRadians);

@@ -30,7 +30,6 @@ struct ViewConfig {
   bool vsync = true;
   bool preview = true;         // lower resolution while the camera moves, when full passes do not fit
   double spinRadians = 0.0;    // orbit per frame
-  ToneMapSettings tone;
   bool fixedSize = false;      // --size given: render resolution fixed, the window scales the image
 };
 

@@ -1,0 +1,143 @@
+// image_settings.cpp — the command line read into ImageSettings, their scene side applied to the
+// Scene, and their text: printed settings and the accumulation identity of checkpoints.
+#include "cli/image_settings.h"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "cli/cli_common.h"
+#include "cli/environment_options.h"
+#include "scene/punctual_lights.h"
+#include "util/error.h"
+
+namespace caustica {
+std::string settingText(ToneCurve v) { return toneCurveName(v); }
+}  // namespace caustica
+
+namespace caustica::cli {
+
+namespace {
+
+RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
+  const RenderSettings defaults;
+  RenderSettings s;
+  parseSize(opts.get("--size", std::to_string(defaultWidth)), camera.aspect, s.width, s.height);
+  s.seed = static_cast<std::uint32_t>(opts.getInt("--seed", static_cast<int>(defaults.seed), 0, 2147483647));
+  s.maxDepth = opts.getInt("--max-depth", defaults.maxDepth, kMinMaxDepth, kMaxMaxDepth);
+  if (!opts.isList("--integrator")) s.integrator = parseIntegrator(opts.get("--integrator", integratorName(defaults.integrator)));
+  if (!opts.isList("--dispersion"))
+    s.dispersion = parseDispersionMode(opts.get("--dispersion", dispersionModeName(defaults.dispersion)));
+  if (!opts.isList("--mode")) s.mode = parseRenderMode(opts.get("--mode", renderModeName(defaults.mode)));
+  s.casterProbability = static_cast<float>(opts.getDouble("--caster-probability", defaults.casterProbability));
+  if (!(s.casterProbability >= 0.0f && s.casterProbability <= kMaxCasterProbability)) {
+    std::ostringstream m;
+    m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
+    throw Error(m.str());
+  }
+  s.allFeatures = opts.has("--all-features");
+  s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
+  s.validate();
+  return s;
+}
+
+SceneSettings sceneSettingsFrom(const Options& opts) {
+  const SceneSettings defaults;
+  SceneSettings s;
+  s.env = opts.get("--env", defaults.env);
+  s.envStrength = static_cast<float>(opts.getDouble("--env-strength", defaults.envStrength));
+  if (!(s.envStrength >= 0.0f)) throw Error("option --env-strength needs a non-negative number");
+  s.envRotation = static_cast<float>(opts.getDouble("--env-rotation", defaults.envRotation));
+  if (!std::isfinite(s.envRotation)) throw Error("option --env-rotation needs a finite number of degrees");
+  s.background = opts.get("--background", defaults.background);
+  parseBackground(s.background);  // a bad colour fails here, before any work
+  if (opts.has("--light-radius")) {
+    const double r = opts.getDouble("--light-radius", 0.0);
+    if (!(r > 0.0) || r > 3.0e38) throw Error("option --light-radius needs a positive number of scene units");
+    s.lightRadius = static_cast<float>(r);
+  }
+  return s;
+}
+
+template <class Each>
+void eachField(const ImageSettings& s, Each&& each) {
+  visitFields(s, [&](const char* name, SettingRole role, const auto& v) { each(name, role, settingText(v)); });
+}
+
+std::map<std::string, std::string> parseLines(const std::string& text) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    size_t sp = line.find(' ');
+    m[line.substr(0, sp)] = sp == std::string::npos ? "" : line.substr(sp + 1);
+  }
+  return m;
+}
+
+}  // namespace
+
+ImageSettings imageSettingsFrom(const Options& opts, const Camera& camera, int defaultWidth) {
+  ImageSettings s;
+  s.render = renderSettingsFrom(opts, camera, defaultWidth);
+  s.scene = sceneSettingsFrom(opts);
+  s.camera = cameraIndexFrom(opts);
+  s.tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", s.tone.exposureStops));
+  s.tone.curve = parseToneCurve(opts.get("--tonemap", toneCurveName(s.tone.curve)));
+  return s;
+}
+
+void applySceneSettings(const ImageSettings& settings, Scene& scene, bool verbose) {
+  const SceneSettings& s = settings.scene;
+  if (s.lightRadius > 0.0f) {
+    const std::size_t before = scene.punctualLights.size();
+    applyLightRadius(scene, s.lightRadius);
+    note(!verbose, "--light-radius: " + std::to_string(before - scene.punctualLights.size()) +
+                       " point/spot light(s) made emissive spheres of radius " + settingText(s.lightRadius));
+  }
+  applyEnvironmentSettings(settings, scene, verbose);  // environment_options.cpp
+}
+
+std::string settingsLines(const ImageSettings& settings, SettingRole role) {
+  std::string out;
+  eachField(settings, [&](const char* name, SettingRole r, const std::string& text) {
+    if (r == role) out += std::string(name) + ' ' + text + '\n';
+  });
+  return out;
+}
+
+std::string settingsSummary(const ImageSettings& settings) {
+  std::string out;
+  eachField(settings, [&](const char* name, SettingRole, const std::string& text) {
+    out += (out.empty() ? "" : ", ") + std::string(name) + ' ' + text;
+  });
+  return out;
+}
+
+std::string accumulationIdentity(const ImageSettings& settings, const Camera& c) {
+  std::string t = settingsLines(settings, SettingRole::Accumulation);
+  t += "camera-view";
+  for (float v : {c.position.x, c.position.y, c.position.z, c.forward.x, c.forward.y, c.forward.z, c.up.x, c.up.y,
+                  c.up.z, c.yfov, c.aspect})
+    t += ' ' + settingText(v);
+  return t + '\n';
+}
+
+std::string identityDifference(const std::string& a, const std::string& b, const std::string& labelA,
+                               const std::string& labelB) {
+  std::vector<std::string> diffs;
+  const std::map<std::string, std::string> ma = parseLines(a), mb = parseLines(b);
+  for (const auto& [key, value] : mb) {
+    auto it = ma.find(key);
+    const std::string other = it == ma.end() ? "(none)" : it->second;
+    if (other != value) diffs.push_back(key + ": " + labelA + ' ' + other + ", " + labelB + ' ' + value);
+  }
+  for (const auto& [key, value] : ma)
+    if (!mb.count(key)) diffs.push_back(key + ": " + labelA + ' ' + value + ", " + labelB + " (none)");
+  std::string out;
+  for (const auto& d : diffs) out += (out.empty() ? "" : "; ") + d;
+  return out;
+}
+
+}  // namespace caustica::cli
