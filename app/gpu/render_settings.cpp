@@ -1,7 +1,7 @@
 // render_settings.cpp — parsing, validation and comparison of RenderSettings.
 #include "gpu/render_settings.h"
 
-#include <iomanip>
+#include <charconv>
 #include <sstream>
 #include <vector>
 
@@ -65,9 +65,9 @@ const char* settingRoleName(SettingRole r) {
 std::string settingText(int v) { return std::to_string(v); }
 std::string settingText(std::uint32_t v) { return std::to_string(v); }
 std::string settingText(float v) {
-  std::ostringstream t;
-  t << std::setprecision(9) << v;
-  return t.str();
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // the shortest text that reads back as v
+  return std::string(buf, r.ptr);
 }
 std::string settingText(bool v) { return v ? "on" : "off"; }
 std::string settingText(const std::string& v) { return v; }

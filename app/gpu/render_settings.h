@@ -96,7 +96,7 @@ void visitFields(Settings& s, Visit&& visit) {
 static_assert(fieldCount<RenderSettings>() == 10, "RenderSettings has a field that visitFields does not list");
 
 // A setting's value as one word of text, the same in the checkpoint identity and printed settings
-// (floats with 9 significant digits, so two floats with the same text are the same float).
+// (a float as the shortest text that reads back as the same float: 0.05f is "0.05").
 std::string settingText(int v);
 std::string settingText(std::uint32_t v);
 std::string settingText(float v);

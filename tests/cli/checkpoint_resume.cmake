@@ -46,7 +46,7 @@ refused("background: checkpoint env, this render 0.2,0.2,0.2"
         ${COMMON} --background 0.2,0.2,0.2 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
 refused("env: checkpoint auto, this render 0.5; env-strength: checkpoint 1, this render 2"
         ${COMMON} --env 0.5 --env-strength 2 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
-refused("light-radius: checkpoint 0, this render 0.0500000007"
+refused("light-radius: checkpoint 0, this render 0.05"
         ${COMMON} --light-radius 0.05 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
 if(EXISTS ${DIR}/x.exr)
   message(FATAL_ERROR "a refused resume wrote an image")

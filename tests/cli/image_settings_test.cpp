@@ -89,7 +89,7 @@ TEST_CASE("image settings: changing any field changes the identity exactly when 
   int accumulation = 0;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const ImageSettings changed = withFieldChanged(i);
-    INFO("field ", list[i].name, " (", settingRoleName(list[i].role), ")");
+    INFO("field ", list[i].name, " (", std::string(settingRoleName(list[i].role)), ")");
     CHECK(settingsSummary(changed) != summary);  // printed, whatever its role
     const std::string other = accumulationIdentity(changed, camera);
     if (list[i].role == SettingRole::Accumulation) {
@@ -145,7 +145,7 @@ TEST_CASE("image settings: every field is read from its option") {
   }
   CHECK(settingsSummary(got).find("width 64, height 32, seed 5") == 0);
   CHECK(accumulationIdentity(got, Camera{}).find("env 0.5\nenv-strength 2\nenv-rotation 30\nbackground 0.2,0.2,0.2\n"
-                                                 "light-radius 0.0500000007\ncamera 1\n") != std::string::npos);
+                                                 "light-radius 0.05\ncamera 1\n") != std::string::npos);
 
   Options bad("test", "", sceneOptionSpecs());
   REQUIRE(bad.parse({"--light-radius", "-1"}));
