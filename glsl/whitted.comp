@@ -15,6 +15,7 @@ bool whittedOccluder(uint material);  // below: emitters do not occlude in this 
 #include "lib/microfacet.glsl"
 #include "lib/materials.glsl"
 #include "lib/point_lights.glsl"
+#include "lib/surface.glsl"
 #include "lib/accumulate.glsl"
 #ifdef CAUSTICA_TRANSPARENT
 #include "lib/coverage.glsl"
@@ -107,85 +108,55 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
 #ifdef CAUSTICA_VOLUME
     w *= exp(-r.sigma * hit.t);
 #endif
-#ifdef CAUSTICA_INSTANCED
-    InstanceXform xf = instanceXform(hit.inst);
-    TriGeom g;
-    vec3 sn0, sn1, sn2;
-    vec2 st0, st1, st2;
-    instanceHitTriangle(hit, xf, g, sn0, sn1, sn2, st0, st1, st2);  // instances.glsl: world space
-#else
-    TriGeom g = triGeomAt(hit.tri);
-    vec3 sn0, sn1, sn2;
-    vec2 st0, st1, st2;
-    triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
-    triUvs(hit.tri, st0, st1, st2);
-#endif
-    float b0 = 1.0 - hit.u - hit.v;
-    vec3 p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
-    vec3 pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);
-#ifdef CAUSTICA_INSTANCED
-    pError += instancePointError(g, xf);
-#endif
-    vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
-    float crLen = length(cr);
-    if (!(crLen > 0.0)) continue;
-    vec3 ngFront = cr / crLen;
-    bool front = dot(r.dir, ngFront) < 0.0;
-    vec3 ng = front ? ngFront : -ngFront;
-    vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
-    float nsLen = length(nsRaw);
-    vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : ngFront;
-    if (dot(ns, ngFront) < 0.0) ns = -ns;
-    if (!front) ns = -ns;
-    vec2 uv = b0 * st0 + hit.u * st1 + hit.v * st2;
-    Material m = materialAt(floatBitsToUint(g.v0.w));
+    Surface sf;
+    if (!surfaceAt(hit, r.dir, false, sf)) continue;  // surface.glsl (Phong shading takes no normal map)
 
-    if (isEmissive(m) && (front || (m.tex.z & kMatDoubleSided) != 0u)) radiance += w * materialEmission(m, uv);
+    if (surfaceEmits(sf)) radiance += w * materialEmission(sf.m, sf.uv);
 
-    vec4 base = materialBaseColor(m, uv);
+    vec4 base = materialBaseColor(sf.m, sf.uv);
     float alpha = 1.0;
 #ifdef CAUSTICA_OPACITY
     alpha = base.a;
-    if (alpha < 1.0) pushRay(offsetRayOrigin(p, pError, -ng), r.dir, w * (1.0 - alpha), r.sigma, r.depth);
+    if (alpha < 1.0) pushRay(offsetRayOrigin(sf.p, sf.pError, -sf.ng), r.dir, w * (1.0 - alpha), r.sigma, r.depth);
 #endif
     float metal = 0.0, trans = 0.0;
 #ifdef CAUSTICA_MIRROR
-    metal = m.params.x;
+    metal = sf.m.params.x;
 #endif
 #ifdef CAUSTICA_GLASS
-    trans = m.params.z;
+    trans = sf.m.params.z;
 #endif
     float diffuseWeight = alpha * (1.0 - metal) * (1.0 - trans);
     if (diffuseWeight > 0.0)
-      radiance += w * diffuseWeight * directLight(p, pError, ng, ns, -r.dir, base.rgb, phongRoughness(m), r.sigma);
+      radiance += w * diffuseWeight * directLight(sf.p, sf.pError, sf.ng, sf.ns, -r.dir, base.rgb, phongRoughness(sf.m), r.sigma);
     if (r.depth + 1u >= maxDepth) continue;
 #ifdef CAUSTICA_MIRROR
     if (metal > 0.0) {
-      vec3 rd = reflect(r.dir, ns);
-      if (dot(rd, ng) <= 0.0) rd = reflect(r.dir, ng);
-      pushRay(offsetRayOrigin(p, pError, ng), rd, w * alpha * metal * base.rgb, r.sigma, r.depth + 1u);
+      vec3 rd = reflect(r.dir, sf.ns);
+      if (dot(rd, sf.ng) <= 0.0) rd = reflect(r.dir, sf.ng);
+      pushRay(offsetRayOrigin(sf.p, sf.pError, sf.ng), rd, w * alpha * metal * base.rgb, r.sigma, r.depth + 1u);
     }
 #endif
 #ifdef CAUSTICA_GLASS
     float glassWeight = alpha * (1.0 - metal) * trans;
     if (glassWeight > 0.0) {
-      float eta = front ? m.params.w : 1.0 / m.params.w;  // n_transmitted / n_incident (at 587.6 nm)
-      vec3 n = ns;
+      float eta = sf.front ? sf.m.params.w : 1.0 / sf.m.params.w;  // n_transmitted / n_incident (at 587.6 nm)
+      vec3 n = sf.ns;
       float cosI = -dot(r.dir, n);
       float f = fresnelDielectric(cosI, eta);
       vec3 rt;
-      bool refracted = f < 1.0 && refractDir(r.dir, n, 1.0 / eta, rt) && dot(rt, ng) < 0.0;
+      bool refracted = f < 1.0 && refractDir(r.dir, n, 1.0 / eta, rt) && dot(rt, sf.ng) < 0.0;
       if (!refracted) f = 1.0;  // total internal reflection (or a misleading shading normal)
       vec3 rr = reflect(r.dir, n);
-      if (dot(rr, ng) <= 0.0) rr = reflect(r.dir, ng);
-      pushRay(offsetRayOrigin(p, pError, ng), rr, w * glassWeight * f, r.sigma, r.depth + 1u);
+      if (dot(rr, sf.ng) <= 0.0) rr = reflect(r.dir, sf.ng);
+      pushRay(offsetRayOrigin(sf.p, sf.pError, sf.ng), rr, w * glassWeight * f, r.sigma, r.depth + 1u);
       if (refracted) {
         vec3 sigmaInside = vec3(0.0);
 #ifdef CAUSTICA_VOLUME
-        sigmaInside = (front && (m.tex.z & kMatHasVolume) != 0u) ? m.absorption.rgb : vec3(0.0);
+        sigmaInside = mediumBeyond(sf);
 #endif
         // Radiance is compressed by eta^2 entering a denser medium (as in the path tracer).
-        pushRay(offsetRayOrigin(p, pError, -ng), rt, w * glassWeight * (1.0 - f) * base.rgb / (eta * eta), sigmaInside,
+        pushRay(offsetRayOrigin(sf.p, sf.pError, -sf.ng), rt, w * glassWeight * (1.0 - f) * base.rgb / (eta * eta), sigmaInside,
                 r.depth + 1u);
       }
     }

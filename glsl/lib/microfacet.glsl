@@ -4,7 +4,7 @@
 // Directions are in the local shading frame (unit, normal = +z); wo points back along the path, wi
 // towards the light. Needs sampling.glsl (PI, luminance, fresnelDielectric, refractDir, sampleCosineHemisphere).
 
-const uint kLobeDiffuse = 0u;     // Lambertian, C / pi (its code stays in pathtrace.comp: caustic casters)
+const uint kLobeDiffuse = 0u;     // Lambertian, C / pi (sampled in path_scatter.glsl: caustic casters)
 const uint kLobeMirror = 1u;      // smooth metal: delta reflection times C
 const uint kLobeGlass = 2u;       // smooth dielectric: delta reflection / refraction
 const uint kLobeConductor = 3u;   // rough metal: GGX, Schlick Fresnel with F0 = C

@@ -1,0 +1,75 @@
+// surface.glsl — the surface a closest hit found, as the path tracer and the Whitted tracer shade it:
+// point and its error bound, geometric and shading normals on the side the ray came from, texcoords
+// and material (world space). Needs bindings.glsl, spawn.glsl, traverse.glsl (instances.glsl), materials.glsl.
+
+struct Surface {
+  vec3 p;        // hit point
+  vec3 pError;   // bound on p's rounding error, per axis (spawn.glsl)
+  vec3 ngFront;  // unit geometric normal of the front (counter-clockwise) face
+  bool front;    // the ray arrived on the front face
+  vec3 ng;       // unit geometric normal on the side the ray came from
+  vec3 ns;       // unit shading normal (interpolated, normal-mapped) on that side
+  vec2 uv;       // texcoords
+  Material m;
+  float t;       // distance along the (unit) ray
+  uint tri;      // the hit's triangle (TriGeom order; instanced: the stored object-space one)
+#ifdef CAUSTICA_INSTANCED
+  TriGeom g;         // the triangle in world space (instanceTriangle)
+  InstanceXform xf;  // its instance
+#endif
+};
+
+// The surface at closest hit `hit` of a ray along unit direction dir; false for a triangle of zero
+// area (no normal: the ray is lost). normalMapped: apply the material's normal map (CAUSTICA_TEXTURES);
+// a constant at each call site, folded away where it is false.
+bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
+#ifdef CAUSTICA_INSTANCED
+  InstanceXform xf = instanceXform(hit.inst);
+  TriGeom g;
+  vec3 sn0, sn1, sn2;
+  vec2 st0, st1, st2;
+  instanceHitTriangle(hit, xf, g, sn0, sn1, sn2, st0, st1, st2);  // instances.glsl: world space
+  sf.g = g;
+  sf.xf = xf;
+#else
+  TriGeom g = triGeomAt(hit.tri);
+  vec3 sn0, sn1, sn2;
+  vec2 st0, st1, st2;
+  triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
+  triUvs(hit.tri, st0, st1, st2);
+#endif
+  sf.t = hit.t;
+  sf.tri = hit.tri;
+  float b0 = 1.0 - hit.u - hit.v;
+  sf.p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
+  sf.pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);  // spawn.glsl
+#ifdef CAUSTICA_INSTANCED
+  sf.pError += instancePointError(g, xf);
+#endif
+  vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
+  float crLen = length(cr);
+  if (!(crLen > 0.0)) return false;
+  sf.ngFront = cr / crLen;
+  sf.front = dot(dir, sf.ngFront) < 0.0;
+  sf.ng = sf.front ? sf.ngFront : -sf.ngFront;
+  vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
+  float nsLen = length(nsRaw);
+  vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : sf.ngFront;
+  if (dot(ns, sf.ngFront) < 0.0) ns = -ns;
+  sf.uv = b0 * st0 + hit.u * st1 + hit.v * st2;
+  sf.m = materialAt(floatBitsToUint(g.v0.w));
+#ifdef CAUSTICA_TEXTURES
+  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
+#endif
+  sf.ns = sf.front ? ns : -ns;
+  return true;
+}
+
+// Whether the surface emits towards the ray (the front face, or both faces when double-sided).
+bool surfaceEmits(Surface sf) { return isEmissive(sf.m) && (sf.front || (sf.m.tex.z & kMatDoubleSided) != 0u); }
+
+// Absorption coefficient (per scene unit) of the medium a ray refracted at sf travels in: the
+// material's volume when it enters one through its front face, else none (it leaves it).
+vec3 mediumBeyond(Surface sf) {
+  return (sf.front && (sf.m.tex.z & kMatHasVolume) != 0u) ? sf.m.absorption.rgb : vec3(0.0);
+}
