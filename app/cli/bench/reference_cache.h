@@ -64,7 +64,7 @@ Reference givenReference(const std::string& file, int width, int height, bool qu
 struct ReferenceRequest {
   std::string scenePath, sceneName;   // the scene file and its name (the file's stem)
   int cameraIndex = 0;                // --camera
-  RenderSettings measured;            // the measured runs' settings (from renderSettingsFrom)
+  RenderSettings measured;            // the measured runs' settings (LoadedScene::settings.render, cli/image_settings.h)
   DispersionMode mode = DispersionMode::Rgb;
   std::optional<PixelRect> caustic;   // for the caustic-region noise estimate
   int spp = 0;                        // samples per pixel, even: two halves of spp / 2
