@@ -20,9 +20,13 @@
 #if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
 #include "lib/punctual.glsl"
 #endif
-#ifdef CAUSTICA_CASTERS
+#if defined(CAUSTICA_CASTERS) || defined(CAUSTICA_MANIFOLD)
 #include "lib/casters.glsl"
 #endif
+#ifdef CAUSTICA_MANIFOLD
+#include "lib/caustic_cells.glsl"
+#endif
+
 #include "lib/vertex.glsl"
 #include "lib/accumulate.glsl"
 #ifdef CAUSTICA_TRANSPARENT
@@ -36,6 +40,10 @@ layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y)
 #include "lib/path_state.glsl"
 #ifdef CAUSTICA_ENV
 #include "lib/environment_light.glsl"
+#endif
+#ifdef CAUSTICA_MANIFOLD
+#include "lib/manifold.glsl"
+#include "lib/path_manifold.glsl"
 #endif
 #include "lib/path_emission.glsl"
 #include "lib/path_nee.glsl"
@@ -62,17 +70,30 @@ bool pathBounce(inout PathState s) {
   if (passThrough(s, sf, base.a)) return true;  // path_scatter.glsl: an alpha cut-out
 #endif
   BounceLobe lobe = chooseBounceLobe(s, sf, base.rgb);  // path_scatter.glsl
+  bool nonDelta = isDiffuseLobe(lobe) || isGlossyLobe(lobe);
+#ifdef CAUSTICA_MANIFOLD
+  bool firstDiffuse = s.firstDiffuse;  // sampleCasterMixture clears it
+#endif
   vec3 newDir;
-  if (isDiffuseLobe(lobe) || isGlossyLobe(lobe)) {
+  Vertex v;
+  if (nonDelta) {
 #ifdef CAUSTICA_CASTERS
     if (isDiffuseLobe(lobe)) newDir = sampleCasterMixture(s, sf);  // its numbers before the lights'
 #endif
-    Vertex v = lobeVertex(s, sf, lobe);
-    addDirectLight(s, v, isDiffuseLobe(lobe));           // path_nee.glsl: next-event estimation
+    v = lobeVertex(s, sf, lobe);
+    addDirectLight(s, v, isDiffuseLobe(lobe));  // path_nee.glsl: next-event estimation
+  }
+#ifdef CAUSTICA_MANIFOLD
+  bool atX = addManifoldLight(s, sf, isDiffuseLobe(lobe), firstDiffuse, v);  // path_manifold.glsl: light through a caster, or the weight of a bounce's
+#endif
+  if (nonDelta) {
     if (!scatterNonDelta(s, sf, v, lobe, newDir)) return false;
   } else {
     scatterDelta(s, sf, lobe, newDir);  // mirror, smooth glass
   }
+#ifdef CAUSTICA_MANIFOLD
+  trackCasterChain(s, sf, lobe.lobe, newDir, atX);
+#endif
   if (!russianRoulette(s)) return false;  // path_state.glsl
   continuePath(s, sf, newDir);
   return true;
@@ -101,6 +122,10 @@ void main() {
     while (true) {
       if (path.depth < maxDepth && pathBounce(path)) continue;
       vec3 l = path.radiance;
+#ifdef CAUSTICA_MANIFOLD_DEBUG
+      l = gDebug;
+      gDebug = vec3(0.0);
+#endif
       bool finite = !(any(isnan(l)) || any(isinf(l)));
       if (!finite) ++bad;  // counted and reported; not part of the pixel's mean (neither as black)
       addSample(sums, finite ? l : vec3(0.0), finite ? 1.0 : 0.0);

@@ -890,6 +890,66 @@ def mirror_caustic():
     return g.finish()
 
 
+def ring(radius, height, thickness, segments):
+    """Open metal ring standing on y = 0: outer wall (radius + thickness) facing out, inner wall
+    (radius) facing in, flat top; smooth normals on the walls, so reflections off it are smooth."""
+    mesh = MeshData()
+    outer, inner = radius + thickness, radius
+    for r, sign in ((outer, 1.0), (inner, -1.0)):
+        first = len(mesh.positions)
+        for j in range(segments + 1):
+            phi = 2.0 * math.pi * j / segments
+            c, s = math.cos(phi), math.sin(phi)
+            n = (sign * c, 0.0, sign * s)
+            mesh.vertex((r * c, 0.0, r * s), n)
+            mesh.vertex((r * c, height, r * s), n)
+        for j in range(segments):
+            a, b, c_, d = first + 2 * j, first + 2 * j + 1, first + 2 * j + 2, first + 2 * j + 3
+            tri1, tri2 = [a, b, c_], [c_, b, d]
+            # front face along the normal (outward for the outer wall, inward for the inner one)
+            p0, p1, p2 = mesh.positions[a], mesh.positions[b], mesh.positions[c_]
+            if dot(cross(sub(p1, p0), sub(p2, p0)), mesh.normals[a]) < 0:
+                tri1, tri2 = [a, c_, b], [c_, d, b]
+            mesh.indices += tri1 + tri2
+    first = len(mesh.positions)
+    for j in range(segments + 1):
+        phi = 2.0 * math.pi * j / segments
+        c, s = math.cos(phi), math.sin(phi)
+        mesh.vertex((outer * c, height, outer * s), (0.0, 1.0, 0.0))
+        mesh.vertex((inner * c, height, inner * s), (0.0, 1.0, 0.0))
+    for j in range(segments):
+        a, b, c_, d = first + 2 * j, first + 2 * j + 1, first + 2 * j + 2, first + 2 * j + 3
+        tri1, tri2 = [a, b, c_], [c_, b, d]
+        p0, p1, p2 = mesh.positions[a], mesh.positions[b], mesh.positions[c_]
+        if cross(sub(p1, p0), sub(p2, p0))[1] < 0:
+            tri1, tri2 = [a, c_, b], [c_, d, b]
+        mesh.indices += tri1 + tri2
+    return mesh
+
+
+def lamp_caustics():
+    """Caustics of a small lamp: a glass ball and a polished metal ring on a white floor, lit by one bulb
+    4 cm wide standing low beside them (a sphere emitter), open to a black sky. The ball focuses the bulb
+    into a small bright spot on the floor beyond it; the ring's inner wall reflects it into the
+    cardioid of a coffee cup. Backward path tracing finds both only by bouncing off the floor into the
+    ball or ring and then hitting the 4 cm bulb: the classic hard case of small-light caustics."""
+    g = Gltf()
+    white = g.material("floor", color=(0.8, 0.8, 0.8))
+    glass = g.material("glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5,
+                       thickness=0.2)
+    metal = g.material("polished metal", color=(0.95, 0.93, 0.88), metallic=1.0, roughness=0.0)
+    floor = MeshData()
+    floor.polygon([(-3, 0, -3), (3, 0, -3), (3, 0, 3), (-3, 0, 3)], (0, 1, 0))
+    g.object("floor", floor, white)
+    g.object("glass ball", uv_sphere(0.1, 64, 32), glass, translation=(-0.25, 0.1, 0.15))
+    g.object("metal ring", ring(0.15, 0.1, 0.006, 96), metal, translation=(0.3, 0.0, -0.25))
+    bulb = g.material("bulb", color=(0.78, 0.78, 0.78), emissive=(1.0, 0.9, 0.75), strength=1500.0)
+    g.object("bulb", uv_sphere(0.02, 16, 8), bulb, translation=(-0.85, 0.5, -0.05))
+    eye, target = (0.0, 1.35, 1.35), (0.0, 0.0, -0.05)
+    g.camera("camera", position=eye, yfov=0.62, rotation=quat_look(sub(target, eye)))
+    return g.finish()
+
+
 # ---- bad inputs ------------------------------------------------------------------------------------
 def triangle_doc(positions=None, indices=(0, 1, 2), mode=None, extra_accessor_count=None):
     """A minimal valid one-triangle scene, returned as a dict to be broken by the caller."""
@@ -1099,6 +1159,7 @@ def main():
         os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
         os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),
         os.path.join(SCENES, "mirror-caustic.gltf"): mirror_caustic(),
+        os.path.join(SCENES, "lamp-caustics.gltf"): lamp_caustics(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),
         os.path.join(TEST_SCENES, "glass-in-white-enclosure.gltf"): furnace(glass=True, albedo=0.0),

@@ -32,6 +32,7 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--seed", "", "S", "random seed of the measured runs (default 1); the reference uses another"},
       sceneOptionSpec("--max-depth"),
       sceneOptionSpec("--caster-probability"),
+      sceneOptionSpec("--manifold"),
       sceneOptionSpec("--camera"),
       sceneOptionSpec("--backend"),
       sceneOptionSpec("--shader-dir"),
