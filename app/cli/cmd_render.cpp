@@ -12,6 +12,7 @@
 #include "cli/cli_common.h"
 #include "cli/load_report.h"
 #include "cli/commands.h"
+#include "cli/shard.h"
 #include "util/error.h"
 #include "util/file_io.h"
 #include "util/memory_stats.h"
@@ -36,6 +37,9 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--checkpoint-file", "", "FILE", "where checkpoints go (default OUTPUT.ckpt)"},
       {"--resume", "", "CHECKPOINT",
        "continue the render saved in CHECKPOINT (same scene and settings; --spp is the new total)"},
+      {"--shard", "", "K/N",
+       "render only the K-th of N disjoint shares of the --spp samples and write them, mergeable, to -o PART.ckpt "
+       "('caustica merge' adds the parts into the image one machine would render; docs/render-farm.md)"},
   };
   for (auto& s : sceneOptionSpecs()) specs.push_back(s);
   Options opts("caustica render [SCENE] [options]",
@@ -47,7 +51,29 @@ int cmdRender(const std::vector<std::string>& args) {
   if (!opts.parse(args)) return 0;
   bool quiet = opts.has("--quiet");
   std::string out = opts.get("--output", "caustica.png");
-  checkImageExtension(out);  // fail before any work
+  const bool sharded = opts.has("--shard");
+  // fail before any work
+  if (sharded) {
+    if (fileExtension(out) != ".ckpt")
+      throw Error(out + ": --shard writes a mergeable partial, not an image: name the output PART.ckpt (caustica merge "
+                        "makes the image from the parts)");
+    // A shard renders a fixed share of the samples, which merge checks; the budgets that stop elsewhere
+    // are refused rather than given a meaning no shard can keep (docs/render-farm.md).
+    if (opts.has("--time"))
+      throw Error("--time with --shard: a shard renders a fixed share of --spp, which --time would leave unfinished "
+                  "(a shard stopped by SIGTERM, e.g. at a scheduler's time limit, writes its partial: continue it with --resume)");
+    if (opts.has("--target-error") || opts.has("--uniform"))
+      throw Error("--target-error with --shard: the error to reach is the merged image's, which no shard sees, and "
+                  "adaptive sampling would give each shard's pixels their own sample counts; render the shards with --spp "
+                  "(caustica merge prints the merged image's estimated relMSE)");
+    if (opts.has("--checkpoint-file"))
+      throw Error("--checkpoint-file with --shard: a shard's partial (-o) is its checkpoint");
+  } else if (fileExtension(out) == ".ckpt") {
+    throw Error(out + ": a .ckpt output is a shard's partial: add --shard K/N (checkpoints of a whole render go to "
+                      "--checkpoint-file)");
+  } else {
+    checkImageExtension(out);
+  }
   RenderBudget budget;
   budget.seconds = opts.getDouble("--time", 0.0);
   if (opts.has("--time") && !(budget.seconds > 0.0 && budget.seconds < 1e9))
@@ -66,7 +92,13 @@ int cmdRender(const std::vector<std::string>& args) {
   const double checkpointSeconds = opts.getDouble("--checkpoint", 0.0);
   if (opts.has("--checkpoint") && !(checkpointSeconds > 0.0))
     throw Error("option --checkpoint needs a number of seconds above 0");
-  const std::string checkpointFile = opts.get("--checkpoint-file", out + ".ckpt");
+  const std::string checkpointFile = sharded ? out : opts.get("--checkpoint-file", out + ".ckpt");
+  std::optional<SampleShare> share;
+  if (sharded) {
+    const auto [k, n] = parseShardOption(opts.get("--shard", ""));
+    share = shareOf(k, n, spp);
+    budget.maxSpp = int(share->end - share->first);
+  }
   checkWritableFile(out, "output");
   checkWritableFile(checkpointFile, "checkpoint");
   std::optional<Checkpoint> resumeFrom;
@@ -86,9 +118,22 @@ int cmdRender(const std::vector<std::string>& args) {
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
   note(quiet, "settings: " + settingsSummary(ls.settings));
+  if (settings.mode == RenderMode::Raster && share)
+    throw Error("--mode raster with --shard: the raster mode draws one deterministic frame, there are no samples to share");
   if (resumeFrom) {
     std::string diff = checkpointMismatch(*resumeFrom, sceneHash, identity);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
+    if (resumeFrom->shard && !share)
+      throw Error(resumePath + ": it is the partial of " + describeShare(*resumeFrom->shard) + " of " +
+                  std::to_string(resumeFrom->shard->total) + " spp: continue it with --shard " +
+                  std::to_string(resumeFrom->shard->index) + "/" + std::to_string(resumeFrom->shard->count) + " --spp " +
+                  std::to_string(resumeFrom->shard->total) + " (or merge the shards with caustica merge)");
+    if (share && !resumeFrom->shard)
+      throw Error(resumePath + ": it is the checkpoint of a whole render, not of a shard: --shard cannot continue it");
+    if (share && *resumeFrom->shard != *share)
+      throw Error(resumePath + ": cannot resume another shard: the file holds " + describeShare(*resumeFrom->shard) +
+                  " of " + std::to_string(resumeFrom->shard->total) + " spp, this render is " + describeShare(*share) +
+                  " of " + std::to_string(share->total) + " spp");
   }
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);
@@ -101,10 +146,13 @@ int cmdRender(const std::vector<std::string>& args) {
                   std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
                   renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
+                  (share ? describeShare(*share) + ", " : std::string()) +
                   (settings.mode == RenderMode::Path ? integratorName(settings.integrator) : renderModeName(settings.mode)));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);
     note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");
+  } else if (share) {
+    renderer.startAtSample(share->first);  // the share's samples, with the whole render's random streams
   }
 
   auto saveCheckpoint = [&] {
@@ -113,6 +161,7 @@ int cmdRender(const std::vector<std::string>& args) {
     ck.seed = settings.seed;
     ck.sceneHash = sceneHash;
     ck.identity = identity;
+    ck.shard = share;
     writeCheckpoint(checkpointFile, ck);
   };
   ProgressHooks hooks;
@@ -121,7 +170,8 @@ int cmdRender(const std::vector<std::string>& args) {
   hooks.checkpoint = saveCheckpoint;
   installInterruptHandlers();
   auto start = std::chrono::steady_clock::now();
-  const BudgetResult result = renderWithBudget(renderer, budget, "", quiet, hooks);
+  const BudgetResult result =
+      renderWithBudget(renderer, budget, share ? "shard " + opts.get("--shard", "") : std::string(), quiet, hooks);
   memTrace("rendered");
   const bool complete = result.reason != StopReason::Interrupted;
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -131,7 +181,7 @@ int cmdRender(const std::vector<std::string>& args) {
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
   note(quiet, loadSummary(renderer, parseSeconds, startToRenderer, ls.scene.triangles.size()));  // load_report.h
-  writeImage(out, renderer.image(), tone);
+  if (!share) writeImage(out, renderer.image(), tone);
   {
     const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);
     note(quiet, "stats " + json);
@@ -148,13 +198,23 @@ int cmdRender(const std::vector<std::string>& args) {
     std::string saved;
     try {
       saveCheckpoint();
-      saved = " and checkpoint " + checkpointFile + " (continue with --resume " + checkpointFile + ")";
+      saved = (share ? " " : " and checkpoint ") + checkpointFile + " (continue with --resume " + checkpointFile + ")";
     } catch (const Error& e) {
       saved = "; no checkpoint: " + std::string(e.what());
     }
-    std::fprintf(stderr, "caustica: interrupted at %d/%d spp after %.0f s; wrote %s (partial)%s\n",
-                 renderer.samplesPerPixel(), spp, total, out.c_str(), saved.c_str());
+    if (share)
+      std::fprintf(stderr, "caustica: interrupted at %d/%d samples of %s after %.0f s; wrote the partial%s\n",
+                   renderer.samplesPerPixel(), budget.maxSpp, describeShare(*share).c_str(), total, saved.c_str());
+    else
+      std::fprintf(stderr, "caustica: interrupted at %d/%d spp after %.0f s; wrote %s (partial)%s\n",
+                   renderer.samplesPerPixel(), spp, total, out.c_str(), saved.c_str());
     return kExitInterrupted;
+  }
+  if (share) {
+    saveCheckpoint();
+    note(quiet, "wrote " + describeShare(*share) + " of " + std::to_string(spp) + " spp to " +
+                    std::filesystem::absolute(out).string() + " (add the parts with caustica merge)");
+    return 0;
   }
   if (checkpointSeconds > 0.0) saveCheckpoint();  // so that the render can be extended later
   note(quiet, "wrote " + std::filesystem::absolute(out).string());

@@ -490,15 +490,20 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
   sampleBase_ = state.sampleBase;
 }
 
-Image Renderer::image() const {
-  std::vector<float> rgba = accum_.readRgba32f();
-  Image img{settings_.width, settings_.height, std::vector<float>(static_cast<size_t>(settings_.width) * settings_.height * 3)};
-  for (size_t i = 0; i < static_cast<size_t>(settings_.width) * settings_.height; ++i) {
+void Renderer::startAtSample(std::uint32_t index) {
+  if (spp_ != 0) throw Error("internal: startAtSample on a render that has samples");
+  sampleBase_ = index;
+}
+
+Image meanImage(int width, int height, const std::vector<float>& rgba, const std::vector<float>* coverage) {
+  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+  Image img{width, height, std::vector<float>(pixels * 3)};
+  for (size_t i = 0; i < pixels; ++i) {
     float n = rgba[i * 4 + 3];
     for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = n > 0.0f ? rgba[i * 4 + c] / n : 0.0f;
   }
-  if (hasAlpha()) {  // rgb stays the mean over all samples (misses add 0): premultiplied by alpha
-    std::vector<float> hits = coverage_.readR32f();
+  if (coverage) {  // rgb stays the mean over all samples (misses add 0): premultiplied by alpha
+    const std::vector<float>& hits = *coverage;
     img.alpha.resize(hits.size());
     for (size_t i = 0; i < hits.size(); ++i) {
       float n = rgba[i * 4 + 3];
@@ -506,6 +511,13 @@ Image Renderer::image() const {
     }
   }
   return img;
+}
+
+Image Renderer::image() const {
+  const std::vector<float> rgba = accum_.readRgba32f();
+  if (!hasAlpha()) return meanImage(settings_.width, settings_.height, rgba, nullptr);
+  const std::vector<float> hits = coverage_.readR32f();
+  return meanImage(settings_.width, settings_.height, rgba, &hits);
 }
 
 const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {

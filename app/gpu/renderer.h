@@ -23,6 +23,7 @@
 #include "image/error_estimate.h"
 #include "image/tonemap.h"
 #include "scene/light_groups.h"
+#include "util/field_count.h"
 
 namespace caustica {
 
@@ -51,6 +52,24 @@ struct AccumulationState {
   std::vector<float> coverage;  // r32f samples whose camera ray hit the scene, width*height; empty unless
                                 // the background is transparent
 };
+
+// The per-pixel sums of an AccumulationState that are plain sums of per-sample values (no compensation
+// term), each as visit(name, images): what adding two states together (merge of shards, cli/shard.h)
+// adds besides accum/comp, which are a Kahan pair. An image empty in a state is absent in it. A field
+// added to AccumulationState must be listed here (or beside accum/comp): the static_assert fails the
+// build until it is, so that merged renders never drop a sum.
+template <class State, class Visit>
+void visitPlainSums(State& s, Visit&& visit) {
+  visit("half", s.half);
+  visit("coverage", s.coverage);
+}
+static_assert(fieldCount<AccumulationState>() == 8,
+              "AccumulationState has a field that visitPlainSums (or the accum/comp pair) does not cover");
+
+// The mean radiance of each pixel from its running sums (rgb / count; 0 where a pixel has no sample),
+// and with `coverage` (hits per pixel) the alpha. Renderer::image() and merge (cli/shard.h) share it, so a
+// merged render's image is computed exactly as one machine's.
+Image meanImage(int width, int height, const std::vector<float>& accum, const std::vector<float>* coverage);
 
 // Seconds the Renderer spent getting a scene ready (docs/benchmarks.md, "Big scenes").
 struct LoadTimes {
@@ -101,6 +120,10 @@ class Renderer {
   // Continues from `state` (saved from a renderer with the same scene and settings): the next pass
   // renders exactly the samples an uninterrupted render would. Throws Error unless its size matches.
   void restoreAccumulation(const AccumulationState& state);
+  // Makes `index` the global index of the next sample (the RNG's sample dimension) of a render that has
+  // no samples yet: a shard of a render starts at the first sample of its share (cli/shard.h).
+  // Throws Error if samples were already added.
+  void startAtSample(std::uint32_t index);
   Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
   // --background transparent in a mode that tracks coverage (path, Whitted; not raster): image() has
   // alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
