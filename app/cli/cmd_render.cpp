@@ -3,7 +3,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "cli/bench/reference_cache.h"
@@ -18,8 +20,160 @@
 #include "util/memory_stats.h"
 #include "image/image_io.h"
 #include "platform/context.h"
+#include "scene/assets.h"
 
 namespace caustica::cli {
+
+namespace {
+
+// --frames A..B: the first and last frame (A <= B, both >= 0).
+std::pair<int, int> parseFrames(const std::string& text) {
+  const auto bad = [&] { return Error("option --frames needs A..B with 0 <= A <= B (frame numbers), got '" + text + "'"); };
+  const size_t dots = text.find("..");
+  if (dots == std::string::npos) throw bad();
+  const auto number = [&](const std::string& t) {
+    char* end = nullptr;
+    const long v = std::strtol(t.c_str(), &end, 10);
+    if (t.empty() || *end != '\0' || v < 0 || v > (1 << 30)) throw bad();
+    return int(v);
+  };
+  const int a = number(text.substr(0, dots)), b = number(text.substr(dots + 2));
+  if (a > b) throw bad();
+  return {a, b};
+}
+
+// The output of frame `n`: the last run of '#' in `pattern` replaced by n, zero-padded to the run's
+// length ("out_####.png", 7 -> "out_0007.png").
+std::string frameFileName(const std::string& pattern, int n) {
+  const size_t last = pattern.find_last_of('#');
+  size_t first = last;
+  while (first > 0 && pattern[first - 1] == '#') --first;
+  std::string number = std::to_string(n);
+  if (number.size() < last - first + 1) number.insert(0, last - first + 1 - number.size(), '0');
+  return pattern.substr(0, first) + number + pattern.substr(last + 1);
+}
+
+// Writes `renderer`'s sums to `file` as the checkpoint of this render (or shard).
+std::function<void()> checkpointWriter(const Renderer& renderer, const std::string& file, std::uint64_t sceneHash,
+                                       const std::string& identity, const std::optional<SampleShare>& shard) {
+  return [&renderer, file, sceneHash, identity, shard] {
+    Checkpoint ck;
+    ck.state = renderer.saveAccumulation();
+    ck.seed = renderer.settings().seed;
+    ck.sceneHash = sceneHash;
+    ck.identity = identity;
+    ck.shard = shard;
+    writeCheckpoint(file, ck);
+  };
+}
+
+// What render does besides rendering: stop between passes on Ctrl-C / SIGTERM, and call `checkpoint`
+// every `checkpointSeconds` (0: never) while it renders.
+ProgressHooks renderHooks(double checkpointSeconds, std::function<void()> checkpoint) {
+  ProgressHooks hooks;
+  hooks.stopOnInterrupt = true;
+  hooks.checkpointSeconds = checkpointSeconds;
+  hooks.checkpoint = std::move(checkpoint);
+  return hooks;
+}
+
+// `render --frames A..B`: an animation's frames in one process, one image each. What does not change
+// from frame to frame is made once: the parsed file and its decoded images (SceneFile), the GL context
+// and the compiled shader variants (Renderer::setScene), and for a rigid animation of an instanced
+// scene the meshes' BVHs (only the instances are placed again; docs/animation.md).
+int renderFrames(const Options& opts, const std::string& pattern, const RenderBudget& budget, Backend backend,
+                 double checkpointSeconds, bool quiet) {
+  for (const char* option : {"--shard", "--resume", "--checkpoint-file", "--stats", "--frame"})
+    if (opts.has(option))
+      throw Error(std::string(option) + " with --frames: render one frame with --frame N for that (a render farm runs a "
+                                        "frame per job: docs/render-farm.md)");
+  const auto [first, last] = parseFrames(opts.get("--frames", ""));
+  if (pattern.find('#') == std::string::npos)
+    throw Error(pattern + ": --frames needs the frame number's place in the output name, as #### (e.g. -o out_####.png)");
+  checkImageExtension(frameFileName(pattern, first));
+  checkWritableFile(frameFileName(pattern, first), "output");
+  const double fps = opts.getDouble("--fps", 24.0);
+  ScenePose pose = scenePoseFrom(opts);  // the animation chosen; the time is each frame's
+  if (opts.positional().size() > 1) throw Error("expected one scene, got " + std::to_string(opts.positional().size()));
+  const std::string path = resolveScenePath(opts.positional().empty() ? kDefaultScene : opts.positional()[0]);
+  const auto commandStart = std::chrono::steady_clock::now();
+  const SceneFile file(path, loadOptionsFrom(opts));
+  const std::uint64_t sceneHash = hashSceneFiles(path);
+  std::string glInfo;
+  auto context = createHeadlessContext(backend, &glInfo);
+  note(quiet, "OpenGL (" + context->backendName() + "): " + glInfo);
+  ShaderLibrary library = shaderLibraryFrom(opts);
+  std::unique_ptr<Renderer> renderer;
+  installInterruptHandlers();
+  const auto seconds = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  double sceneTotal = 0.0, uploadTotal = 0.0, renderTotal = 0.0;
+  for (int n = first; n <= last; ++n) {
+    const auto frameStart = std::chrono::steady_clock::now();
+    pose.time = double(n) / fps;
+    Scene posed = file.sceneAt(pose);
+    if (n == first) {
+      for (const auto& w : posed.warnings) note(quiet, "warning: " + w);
+      note(quiet, posed.animations.empty() ? "warning: " + path + " has no animations: every frame is the same image"
+                                           : path + " has " + animationsSummary(posed));
+    }
+    LoadedScene ls = prepareLoadedScene(std::move(posed), opts, pose, !quiet && n == first);
+    if (ls.settings.render.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, true);
+    const double sceneSeconds = seconds(frameStart);
+    const RenderSettings& settings = ls.settings.render;
+    if (!renderer) {
+      note(quiet, "settings: " + settingsSummary(ls.settings));
+      RendererOptions ro;
+      ro.sceneUpdates = true;
+      renderer = std::make_unique<Renderer>(library, ls.scene, ls.camera, settings, ro);
+    } else {
+      if (renderer->settings() != settings) renderer->apply(settings);
+      renderer->setScene(ls.scene, ls.camera);
+    }
+    const double uploadSeconds = renderer->loadTimes().ready;
+    const std::string out = frameFileName(pattern, n);
+    const std::string checkpointFile = out + ".ckpt";
+    const auto saveCheckpoint =
+        checkpointWriter(*renderer, checkpointFile, sceneHash, accumulationIdentity(ls.settings, ls.camera), std::nullopt);
+    const BudgetResult result = renderWithBudget(*renderer, budget, "frame " + std::to_string(n), quiet,
+                                                 renderHooks(checkpointSeconds, saveCheckpoint));
+    writeImage(out, renderer->image(), ls.settings.tone);
+    if (result.reason == StopReason::Interrupted) {
+      std::string saved;
+      try {
+        saveCheckpoint();
+        saved = " and checkpoint " + checkpointFile;
+      } catch (const Error& e) {
+        saved = "; no checkpoint: " + std::string(e.what());
+      }
+      // Always said, even with --quiet: it explains the exit status.
+      std::fprintf(stderr,
+                   "caustica: interrupted at frame %d, %d spp; wrote %s (partial)%s (continue it with --frame %d --resume "
+                   "%s, then --frames %d..%d)\n",
+                   n, renderer->samplesPerPixel(), out.c_str(), saved.c_str(), n, checkpointFile.c_str(), n + 1, last);
+      return kExitInterrupted;
+    }
+    if (checkpointSeconds > 0.0) saveCheckpoint();
+    sceneTotal += sceneSeconds;
+    uploadTotal += uploadSeconds;
+    renderTotal += result.seconds;
+    char line[256];
+    std::snprintf(line, sizeof line, "frame %d (t = %.4g s): %d spp, scene %.3f s, upload %.3f s, render %.2f s: wrote %s", n,
+                  pose.time, renderer->samplesPerPixel(), sceneSeconds, uploadSeconds, result.seconds, out.c_str());
+    note(quiet, line);
+  }
+  char line[256];
+  const int frames = last - first + 1;
+  std::snprintf(line, sizeof line,
+                "%d frame(s) in %.2f s; a frame: scene %.3f s, upload %.3f s, render %.2f s (mean); mesh BVH builds: %d",
+                frames, seconds(commandStart), sceneTotal / frames, uploadTotal / frames, renderTotal / frames,
+                renderer->meshBvhBuilds());
+  note(quiet, line);
+  return 0;
+}
+
+}  // namespace
 
 int cmdRender(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {
@@ -40,6 +194,9 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--shard", "", "K/N",
        "render only the K-th of N disjoint shares of the --spp samples and write them, mergeable, to -o PART.ckpt "
        "('caustica merge' adds the parts into the image one machine would render; docs/render-farm.md)"},
+      {"--frames", "", "A..B",
+       "render frames A to B of the animation (time N / --fps), one image each, named by -o with #### for the "
+       "frame number (out_####.png); reuses what does not change between frames (docs/animation.md)"},
   };
   for (auto& s : sceneOptionSpecs()) specs.push_back(s);
   Options opts("caustica render [SCENE] [options]",
@@ -53,7 +210,9 @@ int cmdRender(const std::vector<std::string>& args) {
   std::string out = opts.get("--output", "caustica.png");
   const bool sharded = opts.has("--shard");
   // fail before any work
-  if (sharded) {
+  if (opts.has("--frames")) {
+    // checked by renderFrames
+  } else if (sharded) {
     if (fileExtension(out) != ".ckpt")
       throw Error(out + ": --shard writes a mergeable partial, not an image: name the output PART.ckpt (caustica merge "
                         "makes the image from the parts)");
@@ -92,6 +251,7 @@ int cmdRender(const std::vector<std::string>& args) {
   const double checkpointSeconds = opts.getDouble("--checkpoint", 0.0);
   if (opts.has("--checkpoint") && !(checkpointSeconds > 0.0))
     throw Error("option --checkpoint needs a number of seconds above 0");
+  if (opts.has("--frames")) return renderFrames(opts, out, budget, backend, checkpointSeconds, quiet);
   const std::string checkpointFile = sharded ? out : opts.get("--checkpoint-file", out + ".ckpt");
   std::optional<SampleShare> share;
   if (sharded) {
@@ -155,19 +315,8 @@ int cmdRender(const std::vector<std::string>& args) {
     renderer.startAtSample(share->first);  // the share's samples, with the whole render's random streams
   }
 
-  auto saveCheckpoint = [&] {
-    Checkpoint ck;
-    ck.state = renderer.saveAccumulation();
-    ck.seed = settings.seed;
-    ck.sceneHash = sceneHash;
-    ck.identity = identity;
-    ck.shard = share;
-    writeCheckpoint(checkpointFile, ck);
-  };
-  ProgressHooks hooks;
-  hooks.stopOnInterrupt = true;
-  hooks.checkpointSeconds = checkpointSeconds;
-  hooks.checkpoint = saveCheckpoint;
+  const auto saveCheckpoint = checkpointWriter(renderer, checkpointFile, sceneHash, identity, share);
+  const ProgressHooks hooks = renderHooks(checkpointSeconds, saveCheckpoint);
   installInterruptHandlers();
   auto start = std::chrono::steady_clock::now();
   const BudgetResult result =

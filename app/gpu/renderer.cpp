@@ -11,6 +11,7 @@
 #include "accel/tlas.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
+#include "util/hash.h"
 #include "util/memory_stats.h"
 
 namespace caustica {
@@ -65,8 +66,9 @@ gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const s
 
 Renderer::~Renderer() = default;
 
-Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
-    : library_(library), settings_(settings), camera_(camera) {
+Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings,
+                   const RendererOptions& options)
+    : library_(library), options_(options), settings_(settings), camera_(camera) {
   limits_ = queryGlLimits();
   if (limits_.maxComputeStorageBlocks < CAUSTICA_SSBO_COUNT)
     throw Error("this GPU allows " + std::to_string(limits_.maxComputeStorageBlocks) +
@@ -76,20 +78,66 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
   created_ = std::chrono::steady_clock::now();
-  const auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
+  uploadScene(scene);
+  transparent_ = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
+  allocateImages();
+  const auto t0 = std::chrono::steady_clock::now();
+  prepareMode();  // compile now, so shader errors surface before rendering starts
+  load_.compile = secondsSince(t0);
+  memTrace("compiled");
+  load_.ready = secondsSince(created_);
+}
+
+void Renderer::setScene(const Scene& scene, const Camera& camera) {
+  created_ = std::chrono::steady_clock::now();
+  load_ = LoadTimes{};
+  camera_ = camera;
+  raster_.reset();  // the raster pipeline holds the previous scene's mesh
+  uploadScene(scene);
+  const bool transparent = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
+  if (transparent != transparent_) {
+    transparent_ = transparent;
+    allocateImages();  // the coverage image comes or goes (and clears the others)
+  }
+  reset();
+  const auto t0 = std::chrono::steady_clock::now();
+  prepareMode();  // the scene's variant: compiled once, the same features find it in programs_
+  load_.compile = secondsSince(t0);
+  load_.ready = secondsSince(created_);
+}
+
+double Renderer::secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+void Renderer::uploadScene(const Scene& scene) {
+  const auto since = secondsSince;
   auto t0 = std::chrono::steady_clock::now();
   const bool instanced = !scene.instances.empty();
   memTrace("renderer start");
   std::vector<gpu::BvhWideNode> wideNodes;  // what traverse.glsl reads in flat scenes
   if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
-    InstancedBvh ib = buildInstancedBvh(scene);
+    InstancedBvh ib;
+    if (options_.sceneUpdates) {
+      // Animation sequences: the meshes' BVHs are kept while the stored triangles stay the same (a
+      // rigid animation moves only instances), and only the top level is built again.
+      std::uint64_t key = fnv1a64(scene.triangles.data(), scene.triangles.size() * sizeof(Triangle));
+      key = fnv1a64(scene.meshes.data(), scene.meshes.size() * sizeof(MeshRange), key);
+      if (!meshBvhs_ || meshBvhsKey_ != key) {
+        meshBvhs_ = std::make_unique<MeshBvhs>(buildMeshBvhs(scene));
+        meshBvhsKey_ = key;
+        ++meshBvhBuilds_;
+      }
+      ib = placeInstances(scene, *meshBvhs_);
+    } else {
+      ib = buildInstancedBvh(scene);
+    }
     bvhSeconds_ = load_.bvh = since(t0);
     bvh_.depth = ib.depth;
     t0 = std::chrono::steady_clock::now();
     gpuScene_ = packInstancedScene(scene, ib);
   } else {
+    meshBvhs_.reset();
     const BvhShape shape = bvhShapeFromEnv();
     bvh_ = buildBvh(scene.triangles, shape.build);
     memTrace("bvh built");
@@ -161,13 +209,6 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   glFinish();
   load_.upload = since(t0);
   memTrace("upload done");
-  transparent_ = g.environmentParams.size.z == gpu::kBackgroundTransparent;
-  allocateImages();
-  t0 = std::chrono::steady_clock::now();
-  prepareMode();  // compile now, so shader errors surface before rendering starts
-  load_.compile = since(t0);
-  memTrace("compiled");
-  load_.ready = since(created_);
 }
 
 void Renderer::prepareMode() {

@@ -28,6 +28,7 @@
 namespace caustica {
 
 class RasterRenderer;
+struct MeshBvhs;
 
 // The PointLights UBO of the raster and Whitted modes: the emitter `groups`, then the scene's punctual
 // lights (at most CAUSTICA_MAX_POINT_LIGHTS in all), with each light's shadow far distance reaching the
@@ -78,11 +79,29 @@ struct LoadTimes {
   double firstPass = 0.0;    // from the start of the constructor to the end of the first pass (0: none yet)
 };
 
+// How a Renderer will be used beyond one scene.
+struct RendererOptions {
+  // setScene will follow (animation sequences, docs/animation.md): keep the bottom-level BVHs of an
+  // instanced scene on the host (about the meshes' BVH and triangle records again) so that a scene whose
+  // stored meshes did not change only re-places its instances.
+  bool sceneUpdates = false;
+};
+
 class Renderer {
  public:
   // Needs a current GL 4.3 context. Throws Error if the scene exceeds the GL limits.
-  Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings);
+  Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings,
+           const RendererOptions& options = {});
   ~Renderer();
+
+  // Another scene with the same settings (the next frame of an animation): uploads it and restarts
+  // accumulation, keeping what does not depend on the scene: the GL context's compiled shader variants
+  // (the same features reuse theirs), the images (unless the coverage image comes or goes) and, with
+  // RendererOptions::sceneUpdates, the bottom-level BVHs of meshes that did not change (a rigid
+  // animation of an instanced scene rebuilds only the top level). A flat scene's BVH is built again.
+  void setScene(const Scene& scene, const Camera& camera);
+  // Bottom-level BVH builds so far (RendererOptions::sceneUpdates; tests check that rigid frames add none).
+  int meshBvhBuilds() const { return meshBvhBuilds_; }
 
   void setCamera(const Camera& camera);          // restarts accumulation
   // The one place that decides what a settings change needs: new images, another shader variant,
@@ -145,6 +164,10 @@ class Renderer {
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
 
  private:
+  static double secondsSince(std::chrono::steady_clock::time_point t);
+  // Everything of the scene on the GPU: BVH, packed arrays, buffers and their views, UBOs, the
+  // environment (what the constructor and setScene share).
+  void uploadScene(const Scene& scene);
   const GlProgram& program();
   void prepareMode();  // compiles the current mode's compute variant, or builds the raster pipeline
   void allocateImages();
@@ -153,6 +176,10 @@ class Renderer {
   void uploadCasters();
 
   const ShaderLibrary& library_;
+  RendererOptions options_;
+  std::unique_ptr<MeshBvhs> meshBvhs_;  // sceneUpdates: the instanced scene's bottom levels, and
+  std::uint64_t meshBvhsKey_ = 0;       // the hash of the stored triangles and meshes they were built from
+  int meshBvhBuilds_ = 0;
   RenderSettings settings_;
   Camera camera_;
   Bvh bvh_;
