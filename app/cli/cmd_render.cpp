@@ -190,7 +190,9 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--checkpoint", "", "SECONDS", "rewrite a checkpoint every SECONDS (atomically) and at the end"},
       {"--checkpoint-file", "", "FILE", "where checkpoints go (default OUTPUT.ckpt)"},
       {"--resume", "", "CHECKPOINT",
-       "continue the render saved in CHECKPOINT (same scene and settings; --spp is the new total)"},
+       "continue the render saved in CHECKPOINT (same scene and settings; --spp is the new total); auto: the "
+       "checkpoint this render writes (--checkpoint-file, or a shard's -o) if it exists, else start (for job scripts "
+       "that may run again)"},
       {"--shard", "", "K/N",
        "render only the K-th of N disjoint shares of the --spp samples and write them, mergeable, to -o PART.ckpt "
        "('caustica merge' adds the parts into the image one machine would render; docs/render-farm.md)"},
@@ -262,8 +264,11 @@ int cmdRender(const std::vector<std::string>& args) {
   checkWritableFile(out, "output");
   checkWritableFile(checkpointFile, "checkpoint");
   std::optional<Checkpoint> resumeFrom;
-  const std::string resumePath = opts.get("--resume", "");
-  if (opts.has("--resume")) resumeFrom = readCheckpoint(resumePath);  // a bad file fails before any work
+  const bool resumeAuto = opts.get("--resume", "") == "auto";
+  const std::string resumePath = resumeAuto ? checkpointFile : opts.get("--resume", "");
+  // A bad file fails before any work; with auto, a missing one starts the render (a first run).
+  if (opts.has("--resume") && (!resumeAuto || std::filesystem::exists(resumePath))) resumeFrom = readCheckpoint(resumePath);
+  else if (resumeAuto) note(quiet, "--resume auto: no " + resumePath + " yet, starting the render");
 
   memTrace("command start");
   const auto commandStart = std::chrono::steady_clock::now();

@@ -84,8 +84,11 @@ render_refused("p2.ckpt: it is the partial of shard 2/3 \\(samples 2-5\\) of 10 
 
 # Faults: shard 2/2 of 8000 spp writes its partial every 0.3 s and is killed (SIGKILL: no handler runs)
 # after its first one; the partial is unfinished, merge names it, and resuming it completes the set.
-set(BIG ${COMMON} --spp 8000)
-run(0 ${BIG} --shard 1/2 -o ${DIR}/big1.ckpt)
+set(BIG cornell-box --size 16 --backend osmesa --spp 8000)  # not quiet: the resume lines are checked
+run(0 ${BIG} --shard 1/2 -o ${DIR}/big1.ckpt --resume auto)
+if(NOT err MATCHES "--resume auto: no [^ ]*big1.ckpt yet, starting the render")
+  message(FATAL_ERROR "--resume auto without a partial does not say it starts: ${err}")
+endif()
 execute_process(
   COMMAND sh -c "\"$0\" render $1 --shard 2/2 -o \"$2\" --checkpoint 0.3 &
 pid=$!
@@ -101,7 +104,11 @@ if(NOT out MATCHES "exit=137")
 endif()
 merge_refused("big2.ckpt: shard 2/2 \\(samples 4000-7999\\) is incomplete: it holds samples 4000-[0-9]+ \\(continue it with render --shard 2/2 --resume .*big2.ckpt\\)"
               ${DIR}/big1.ckpt ${DIR}/big2.ckpt -o ${DIR}/x.exr)
-run(0 ${BIG} --shard 2/2 -o ${DIR}/big2.ckpt --resume ${DIR}/big2.ckpt)
+# --resume auto: the job script's one command line continues the partial (and starts when there is none).
+run(0 ${BIG} --shard 2/2 -o ${DIR}/big2.ckpt --resume auto)
+if(NOT err MATCHES "resumed [^ ]*big2.ckpt at [0-9]+ spp")
+  message(FATAL_ERROR "--resume auto did not continue the partial: ${err}")
+endif()
 merge_run(0 ${DIR}/big1.ckpt ${DIR}/big2.ckpt -o ${DIR}/big.exr)
 run(0 ${BIG} -o ${DIR}/big-one.exr)
 same(${DIR}/big.exr ${DIR}/big-one.exr)
