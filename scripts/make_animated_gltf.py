@@ -136,7 +136,9 @@ def quat(axis, degrees):
 #               out-tangent (1, 2, 0) at key 0 and in-tangent (1, -2, 0) at key 1 (units per second);
 #               its mesh is the cube's (one mesh placed twice).
 #   node "camera": translation LINEAR (0, 1.5, 6) -> (0.5, 1.5, 5) at t = 0, 2.
-# Animation 1 "spin" (0..1 s): node "box" rotation STEP: identity, then 90 deg about +Y at t = 0.5.
+# Animation 1 "spin" (0..1 s): node "box" rotation STEP: identity, then 90 deg about +Y at t = 0.5, and
+# its translation held at its node's value (so "move" and "spin" animate the same property: an
+# alternative motion, not a part of one; by default only the first plays).
 TRS_CUBE_T = [[-1.0, 0.5, 0.0], [1.0, 0.5, 0.0], [1.0, 1.5, 0.0]]
 TRS_CUBE_R = [quat((0, 1, 0), 0), [-x for x in quat((0, 1, 0), 60)], quat((0, 1, 0), 120)]
 TRS_CUBE_S = [[1.0, 1.0, 1.0], [0.5, 0.5, 0.5]]
@@ -177,6 +179,7 @@ def write_trs():
     channel(move, cam, "translation", [0.0, 2.0], TRS_CAMERA_T, "VEC3", "LINEAR")
     spin = {"name": "spin", "channels": [], "samplers": []}
     channel(spin, box_node, "rotation", [0.0, 0.5], [quat((0, 1, 0), 0), quat((0, 1, 0), 90)], "VEC4", "STEP")
+    channel(spin, box_node, "translation", [0.0], [TRS_BOX_C[1]], "VEC3", "STEP")
     b.doc["animations"] = [move, spin]
     b.write("trs.gltf")
 
@@ -280,6 +283,25 @@ def write_skin():
     b.write("skin.gltf")
 
 
+# ---- split.gltf: one motion written as one animation per node (as COLLADA2GLTF does) --------------
+# Animation "a" moves node "left" from x = -1 to x = -2, animation "b" node "right" from x = 1 to x = 2,
+# LINEAR over 0..1 s. No two animate the same property, so by default both play.
+def write_split():
+    b = Builder()
+    grey = b.material((0.7, 0.7, 0.7))
+    box = b.mesh(*cube(), grey)
+    left = b.node(name="left", mesh=box, translation=[-1.0, 0.5, 0.0])
+    right = b.node(name="right", mesh=box, translation=[1.0, 0.5, 0.0])
+    anims = []
+    for name, node, x0, x1 in (("a", left, -1.0, -2.0), ("b", right, 1.0, 2.0)):
+        anims.append({"name": name, "samplers": [
+            {"input": b.accessor([0.0, 1.0], "SCALAR", minmax=True),
+             "output": b.accessor([x0, 0.5, 0.0, x1, 0.5, 0.0], "VEC3"), "interpolation": "LINEAR"}],
+            "channels": [{"sampler": 0, "target": {"node": node, "path": "translation"}}]})
+    b.doc["animations"] = anims
+    b.write("split.gltf")
+
+
 # ---- broken animations (tests/data/bad: each must fail with a message naming the file) --------------
 def write_bad():
     def one(name, times, values, interpolation="LINEAR"):
@@ -312,4 +334,5 @@ if __name__ == "__main__":
     write_morph()
     write_morph_at_1()
     write_skin()
+    write_split()
     write_bad()

@@ -150,7 +150,8 @@ std::vector<OptionSpec> animationOptionSpecs() {
       {"--frame", "", "N", "pose it at frame N of --fps frames a second (time N / F)"},
       {"--fps", "", "F", "frames a second for --frame and --frames (default 24)"},
       {"--animation", "", "NAME|INDEX",
-       "which of the file's animations plays: its name or index, or all (default: the first)"},
+       "which of the file's animations plays: its name or index, or all (default: all when no two animate the "
+       "same node property, else the first)"},
   };
 }
 
@@ -186,16 +187,23 @@ std::string animationsSummary(const Scene& s) {
     return std::string(b);
   };
   std::string out = std::to_string(s.animations.size()) + (s.animations.size() == 1 ? " animation: " : " animations: ");
+  constexpr std::size_t kListed = 4;  // files with one animation per node have dozens
   for (std::size_t i = 0; i < s.animations.size(); ++i) {
+    if (i == kListed) {
+      out += ", ... (" + std::to_string(s.animations.size() - kListed) + " more)";
+      break;
+    }
     const AnimationInfo& a = s.animations[i];
     out += (i ? ", " : "") + std::to_string(i) + (a.name.empty() ? "" : " '" + a.name + "'") + " " + seconds(a.start) +
            "-" + seconds(a.end) + " s (" + std::to_string(a.channels) + (a.channels == 1 ? " channel" : " channels") +
            (a.weights ? ", morph weights" : "") + (a.skins ? ", skin joints" : "") + ")";
   }
   std::string played;
-  for (int i : s.animationsPlayed)
-    played += (played.empty() ? "" : " and ") + std::to_string(i) +
-              (s.animations[std::size_t(i)].name.empty() ? "" : " '" + s.animations[std::size_t(i)].name + "'");
+  if (s.animationsPlayed.size() > 1 && s.animationsPlayed.size() == s.animations.size()) played = "all";
+  else
+    for (int i : s.animationsPlayed)
+      played += (played.empty() ? "" : " and ") + std::to_string(i) +
+                (s.animations[std::size_t(i)].name.empty() ? "" : " '" + s.animations[std::size_t(i)].name + "'");
   return out + "; showing " + (played.empty() ? "none" : played) + " at t = " + seconds(s.animationTime) + " s";
 }
 

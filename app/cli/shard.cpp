@@ -103,8 +103,13 @@ MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) 
       throw Error(p.path + " and " + ref.path + " have different image sizes (" + std::to_string(b.state.width) + "x" +
                   std::to_string(b.state.height) + " and " + std::to_string(a.state.width) + "x" +
                   std::to_string(a.state.height) + ")");
-    if (b.state.coverage.size() != a.state.coverage.size())
-      throw Error(p.path + " and " + ref.path + ": one has a coverage (alpha) image and the other not");
+    // Every per-pixel sum (half image, coverage, ...: visitPlainSums) is in both or in neither.
+    visitPlainSums(a.state, [&](const char* name, const std::vector<float>& sa) {
+      visitPlainSums(b.state, [&](const char* other, const std::vector<float>& sb) {
+        if (std::string(name) == other && sa.size() != sb.size())
+          throw Error(p.path + " and " + ref.path + ": one holds the " + name + " sums and the other not (or of another size)");
+      });
+    });
   }
   // Shares: sorted by their first sample; no two may overlap (the same shard given twice included).
   std::vector<const MergePart*> order;

@@ -57,8 +57,9 @@ struct AccumulationState {
 // The per-pixel sums of an AccumulationState that are plain sums of per-sample values (no compensation
 // term), each as visit(name, images): what adding two states together (merge of shards, cli/shard.h)
 // adds besides accum/comp, which are a Kahan pair. An image empty in a state is absent in it. A field
-// added to AccumulationState must be listed here (or beside accum/comp): the static_assert fails the
-// build until it is, so that merged renders never drop a sum.
+// added to AccumulationState (e.g. another per-pixel sum: feature buffers) must be listed here (or
+// beside accum/comp): the static_assert fails the build until it is, so that merged renders never drop
+// a sum; merge then adds it and refuses parts that hold it next to parts that do not.
 template <class State, class Visit>
 void visitPlainSums(State& s, Visit&& visit) {
   visit("half", s.half);

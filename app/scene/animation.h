@@ -72,8 +72,8 @@ struct AnimationInfo {
 
 // Which animation(s) a scene is posed with and when (render --anim-time/--frame/--animation).
 struct ScenePose {
-  // "" : the file's first animation (the only one in most files); "all": every animation at once; else
-  // an animation's name or its index.
+  // "": the default: every animation when no two animate the same property of a node (one motion split
+  // per node), else the first; "all": every animation at once; else an animation's name or its index.
   std::string animation;
   double time = 0.0;  // seconds
 };

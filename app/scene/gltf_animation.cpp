@@ -57,10 +57,21 @@ void SceneBuilder::readAnimations() {
       fail("--animation " + oneLine(pose_.animation) + ": the file has no animations");
     return;
   }
-  // Which animations play: the first by default, every one with "all", else one by index or name.
+  // Which animations play. By default: every one when no two animate the same property of a node
+  // (exporters such as COLLADA2GLTF write one animation per node of one motion), else the first (the
+  // file holds alternative motions: Walk, Run, ...). "all": every one; else one by name or index.
   std::vector<bool> played(count, false);
   if (pose_.animation.empty()) {
-    played[0] = true;
+    std::set<std::pair<int, std::string>> targets;
+    bool disjoint = true;
+    for (const tinygltf::Animation& anim : model_.animations) {
+      std::set<std::pair<int, std::string>> own;
+      for (const tinygltf::AnimationChannel& ch : anim.channels)
+        if (ch.target_node >= 0) own.emplace(ch.target_node, ch.target_path);
+      for (const auto& t : own) disjoint = disjoint && targets.insert(t).second;
+    }
+    if (disjoint) played.assign(count, true);
+    else played[0] = true;
   } else if (pose_.animation == "all") {
     played.assign(count, true);
   } else {

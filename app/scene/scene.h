@@ -229,7 +229,7 @@ std::uint64_t instancedTriangleCount(const Scene& scene);
 // Loads a .gltf or .glb file posed at `pose` (its animations, morph-target weights and skins at that
 // time; docs/animation.md). Throws caustica::Error("FILE: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const LoadOptions& options, const ScenePose& pose);
-// The same at time 0 of the file's first animation (if it has any).
+// The same at time 0 of the default animation(s) (ScenePose{}), if the file has any.
 Scene loadScene(const std::string& path, const LoadOptions& options);
 // The same with the default LoadOptions.
 Scene loadScene(const std::string& path);

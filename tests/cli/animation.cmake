@@ -48,7 +48,7 @@ identical(${DIR}/skin_1.exr ${DIR}/skin-single.exr)
 
 # No time given: t = 0, and it says so.
 run(0 ${DATA}/trs.gltf ${COMMON} -o ${DIR}/t0.exr)
-if(NOT err MATCHES "trs.gltf has 2 animations: 0 'move' 0-2 s \\(5 channels\\), 1 'spin' 0-0.5 s \\(1 channel\\); showing 0 'move' at t = 0 s \\(choose the time with --anim-time")
+if(NOT err MATCHES "trs.gltf has 2 animations: 0 'move' 0-2 s \\(5 channels\\), 1 'spin' 0-0.5 s \\(2 channels\\); showing 0 'move' at t = 0 s \\(choose the time with --anim-time")
   message(FATAL_ERROR "an animated file rendered without a time does not say it shows t = 0: ${err}")
 endif()
 

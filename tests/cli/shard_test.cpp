@@ -237,6 +237,11 @@ TEST_CASE("merge: every bad set of parts is refused, naming the files and the pr
     CHECK(r.resumable);
     CHECK(r.merged.state.sampleBase == 8u);
   }
+  {  // a part with a sum image the others lack (here coverage: --background transparent)
+    std::vector<MergePart> q = p;
+    q[3].checkpoint.state.coverage.assign(2, 1.0f);
+    refused(q, "p4.ckpt and p1.ckpt: one holds the coverage sums and the other not");
+  }
   {  // a part whose samples lie outside its share (a hand-edited or mixed-up file)
     std::vector<MergePart> q = p;
     q[0].checkpoint.state.sampleBase = 9;
