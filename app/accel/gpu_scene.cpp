@@ -1,4 +1,4 @@
-// gpu_scene.cpp — Scene + BVH to shader storage arrays; emitter alias table; feature detection.
+// gpu_scene.cpp — Scene + BVH to shader storage arrays; the emitters' light tree; feature detection.
 #include "accel/gpu_scene.h"
 
 #include <cmath>
@@ -76,39 +76,6 @@ SceneFeatures sceneFeatures(const Scene& scene) {
   f.punctual = !scene.punctualLights.empty();
   for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
   return f;
-}
-
-std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items) {
-  size_t n = weights.size();
-  std::vector<gpu::Emitter> table(n);
-  double total = 0.0;
-  for (double w : weights) total += w;
-  if (n == 0 || !(total > 0.0)) return {};
-  std::vector<double> scaled(n);
-  std::vector<size_t> small, large;
-  for (size_t i = 0; i < n; ++i) {
-    scaled[i] = weights[i] * static_cast<double>(n) / total;
-    (scaled[i] < 1.0 ? small : large).push_back(i);
-    table[i].tri = items[i];
-    table[i].pdfSelect = static_cast<float>(weights[i] / total);
-    table[i].alias = static_cast<std::uint32_t>(i);
-    table[i].prob = 1.0f;
-  }
-  while (!small.empty() && !large.empty()) {
-    size_t s = small.back(), l = large.back();
-    small.pop_back();
-    table[s].prob = static_cast<float>(scaled[s]);
-    table[s].alias = static_cast<std::uint32_t>(l);
-    scaled[l] -= 1.0 - scaled[s];
-    if (scaled[l] < 1.0) {
-      large.pop_back();
-      small.push_back(l);
-    }
-  }
-  // Leftovers are 1 up to rounding.
-  for (size_t i : small) table[i].prob = 1.0f;
-  for (size_t i : large) table[i].prob = 1.0f;
-  return table;
 }
 
 namespace {
@@ -262,8 +229,6 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   packMaterialsAndTextures(scene, g);
 
   // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
-  std::vector<double> weights;
-  std::vector<std::uint32_t> tris;
   double totalWeight = 0.0;
   std::vector<LightTreeItem> lightItems;
   for (size_t i = 0; i < g.triangleCount; ++i) {
@@ -272,18 +237,16 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
     if (!m.isEmissive()) continue;
     const double w = emitterWeight(m, tri.p);  // tri.p: TriGeom's vertices
     if (w == 0.0) continue;
-    weights.push_back(w);
-    tris.push_back(static_cast<std::uint32_t>(i));
     totalWeight += w;
     lightItems.push_back(emitterItem(static_cast<std::uint32_t>(i), tri.p, w, m.doubleSided));
   }
   // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
   // TriGeom.v1.w (leaf index + 1 as uint bits, 0: not in the tree).
+  g.emitterCount = lightItems.size();
   g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
   if (triangleArrays) packTriangleRange(scene, bvh, g, 0, g.triangleCount, g.triGeom, g.triShade);
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
-  g.emitters = buildAliasTable(weights, tris);
   return g;
 }
 
@@ -335,8 +298,6 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   }
 
   // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
-  std::vector<double> weights;
-  std::vector<std::uint32_t> items;
   std::vector<LightTreeItem> lightItems;
   double totalWeight = 0.0;
   for (std::size_t e = 0; e < lights.triangles.size(); ++e) {
@@ -345,17 +306,15 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     if (!m.isEmissive()) continue;
     const double w = emitterWeight(m, tri.p);
     if (w == 0.0) continue;
-    weights.push_back(w);
-    items.push_back(static_cast<std::uint32_t>(lightItems.size()));
     totalWeight += w;
     lightItems.push_back(emitterItem(storedIndex[source[e].triangle], tri.p, w, m.doubleSided));
     lightItems.back().instance = source[e].instance;
   }
+  g.emitterCount = lightItems.size();
   g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);  // per stored triangle: meaningless here
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
-  g.emitters = buildAliasTable(weights, items);
 
   // The light-leaf table: per instance of an emissive mesh, its emitters' leaves in emissiveIndex order.
   std::vector<std::uint32_t> leafBase(scene.instances.size(), 0);

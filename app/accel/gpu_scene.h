@@ -1,5 +1,5 @@
 // gpu_scene.h — packs a Scene and its BVH into the arrays the shaders read (gpu_layout.h), builds
-// the emitter alias table, and decides which shader features the scene needs.
+// the light tree over the emitters, and decides which shader features the scene needs.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -35,7 +35,7 @@ struct GpuScene {
   std::vector<std::uint32_t> triShade;  // BVH leaf order, triShadeStride words per triangle (gpu_layout.h)
   std::uint32_t triShadeStride = gpu::kTriShadeWords;  // kTriShadeWordsTextured when features.textures
   std::vector<gpu::Material> materials;
-  std::vector<gpu::Emitter> emitters;   // alias table, one slot per emissive triangle (host only: counts, info)
+  std::size_t emitterCount = 0;         // emissive triangles of positive power: the light tree's leaves
   LightTree lightTree;                  // light tree over the same triangles: what the shaders sample (binding 4)
   std::vector<std::uint32_t> texels;    // RGBA8 packed as unpackUnorm4x8 reads them
   std::vector<gpu::TexInfo> texInfo;
@@ -83,8 +83,5 @@ struct GpuSceneBytes {
   std::size_t total() const { return nodes + triGeom + triShade + materials + lightTree + textures; }
 };
 GpuSceneBytes gpuSceneBytes(const GpuScene& g);
-
-// Vose's alias table over `weights` (non-negative, not all zero). Slot i holds item `items[i]`.
-std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items);
 
 }  // namespace caustica

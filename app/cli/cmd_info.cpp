@@ -72,9 +72,9 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("triangles:  %zu\n", s.triangles.size());
   std::printf("instances:  %s\n", instanced ? (instancesSummary(g) + " of " + std::to_string(s.meshes.size()) + " meshes").c_str()
                                             : instancesSummary(g).c_str());
-  std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitters.size(),
+  std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitterCount,
               g.totalPower);
-  std::printf("lighting:   %s\n", lightingSummary(s, g.emitters.size()).c_str());
+  std::printf("lighting:   %s\n", lightingSummary(s, g.emitterCount).c_str());
   // KHR_lights_punctual, with their share of the light choices (by power, punctual_lights.h).
   std::printf("punctual:   %zu light(s)%s\n", s.punctualLights.size(),
               s.punctualLights.empty() ? "" : " (point/spot: intensity in cd; directional: lux; chosen by power)");

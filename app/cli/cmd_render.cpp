@@ -98,7 +98,7 @@ int cmdRender(const std::vector<std::string>& args) {
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
-                  std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
+                  std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
                   renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
                   (settings.mode == RenderMode::Path ? integratorName(settings.integrator) : renderModeName(settings.mode)));

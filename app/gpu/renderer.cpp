@@ -202,12 +202,12 @@ std::vector<std::string> Renderer::shaderDefines() const {
   for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
   if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
   if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
-  if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
+  if (settings_.integrator == Integrator::Mis && (gpuScene_.emitterCount > 0 || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
     // No emissive triangles (mis for the environment alone): the emitter estimate and the emitter-hit
     // pdf are left out rather than run masked on every bounce (llvmpipe runs every branch; vertex.glsl).
-    if (gpuScene_.emitters.empty() && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
+    if (gpuScene_.emitterCount == 0 && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
   }
   if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
@@ -429,7 +429,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
       sinceRead = 0;
     }
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), std::uint32_t(k));
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), std::uint32_t(k));
     frameUbo_.update(0, sizeof fp, &fp);
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);

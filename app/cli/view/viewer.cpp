@@ -206,7 +206,7 @@ void Viewer::updateTitle(bool force) {
   lastTitle_ = t;
   const RenderSettings& wanted = controls_.wanted;
   std::string title = "caustica view - " + sceneName_ + " | " +
-                      lightingTag(scene_.scene, renderer_->gpuScene().emitters.size()) + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
+                      lightingTag(scene_.scene, renderer_->gpuScene().emitterCount) + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
                       format("%.3g samples/s", samplesPerSecond_) + " | " + format("%.1f ms/frame", frameMs_) + " | " +
                       integratorName(wanted.integrator) +
                       (wanted.integrator == Integrator::Mis && !renderer_->gpuScene().casters.empty()
