@@ -171,11 +171,12 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
 }
 
 void Renderer::prepareMode() {
-  if (settings_.mode != RenderMode::Raster) {
+  const RenderModeSpec& mode = renderModeSpec(settings_.mode);
+  if (!mode.instancedScenes && gpuScene_.instanceCount > 0)
+    throw Error(std::string(mode.name) + " mode draws flattened scenes only: load this scene with --instances off");
+  if (mode.entryShader) {
     program();
   } else if (!raster_) {
-    if (gpuScene_.instanceCount > 0)
-      throw Error("raster mode draws flattened scenes only: load this scene with --instances off");
     downloadSceneArrays(gpuScene_, bufferLayout_, buffers_);  // the raster mesh is built from them
     raster_ = std::make_unique<RasterRenderer>(library_, gpuScene_, pointLights_);
     std::vector<gpu::TriGeom>().swap(gpuScene_.triGeom);
@@ -195,13 +196,14 @@ std::vector<std::string> allMaterialFeatureDefines() {
 
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = gpuScene_.features.defines();
-  if (settings_.allFeatures && settings_.mode == RenderMode::Path) d = allMaterialFeatureDefines();
+  const RenderModeSpec& mode = renderModeSpec(settings_.mode);
+  if (settings_.allFeatures && mode.pathTracer) d = allMaterialFeatureDefines();
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
   if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
-  if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
+  if (!mode.pathTracer) return d;  // Whitted: materials only; raster: no compute variant
   if (settings_.integrator == Integrator::Mis && (gpuScene_.emitterCount > 0 || gpuScene_.environment.width > 0)) {
     d.push_back("CAUSTICA_MIS");
     if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
@@ -215,7 +217,7 @@ std::vector<std::string> Renderer::shaderDefines() const {
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
-  const char* entry = settings_.mode == RenderMode::Whitted ? "whitted.comp" : "pathtrace.comp";
+  const char* entry = renderModeSpec(settings_.mode).entryShader;
   std::string key = std::string(entry) + ":";
   for (const auto& d : defines) key += d + " ";
   auto it = programs_.find(key);
@@ -299,9 +301,9 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   y0 = std::max(0, y0);
   y1 = std::min(settings_.height, y1);
   if (y1 <= y0 || spp <= 0) return;
-  if (settings_.mode == RenderMode::Raster) {
-    // One deterministic frame drawn straight into the accumulation image (alpha = 1 sample), once
-    // per restart: later passes would only draw the same frame again.
+  if (!renderModeSpec(settings_.mode).entryShader) {
+    // The raster pipeline: one deterministic frame drawn straight into the accumulation image (alpha
+    // = 1 sample), once per restart (SampleRule::OneFrame): later passes would only draw it again.
     if (spp_ == 0 && y0 == 0) {
       prepareMode();
       pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
@@ -314,7 +316,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
 }
 
 void Renderer::renderPass(int spp) {
-  if (tileListActive_ && settings_.mode != RenderMode::Raster) {  // raster: one frame, no samples to spread
+  if (tileListActive_ && renderModeSpec(settings_.mode).samples != SampleRule::OneFrame) {  // one frame: no samples to spread
     if (liveTiles_ > 0 && spp > 0) dispatchSamples(spp, 0, settings_.height, true);
   } else {
     renderRows(0, settings_.height, spp);
@@ -365,7 +367,7 @@ constexpr int kMaxPassThroughs = 256;          // pathtrace.comp's kMaxPassThrou
 }  // namespace
 
 int Renderer::samplesPerDispatch() const {
-  if (settings_.mode != RenderMode::Path) return 1;  // whitted.comp traces one sample per dispatch
+  if (renderModeSpec(settings_.mode).samples != SampleRule::Regeneration) return 1;
   const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
   int perSample = settings_.maxDepth;
   const std::vector<std::string> defines = shaderDefines();

@@ -91,10 +91,10 @@ class Renderer {
   ErrorEstimate errorEstimate(int tileSize = CAUSTICA_WORKGROUP_X) const;
 
   int samplesPerPixel() const { return spp_; }
-  // Samples per pixel one path-tracing dispatch traces (pathtrace.comp's flat bounce loop, path
-  // regeneration): settings().samplesPerDispatch or the default, lowered so that K * (depth cap +
-  // alpha pass-throughs) <= kRegenBounceBudget; 1 in the Whitted and raster modes. A render loop
-  // should ask for passes of at least this many samples, or the dispatches trace fewer.
+  // Samples per pixel one dispatch traces: in modes of SampleRule::Regeneration (pathtrace.comp's flat
+  // bounce loop) settings().samplesPerDispatch or the default, lowered so that K * (depth cap + alpha
+  // pass-throughs) <= kRegenBounceBudget; else 1. A render loop should ask for passes of at least
+  // this many samples, or the dispatches trace fewer.
   int samplesPerDispatch() const;
   // Reads back both accumulation images and the sample counters (for checkpoints).
   AccumulationState saveAccumulation() const;
@@ -102,9 +102,9 @@ class Renderer {
   // renders exactly the samples an uninterrupted render would. Throws Error unless its size matches.
   void restoreAccumulation(const AccumulationState& state);
   Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
-  // --background transparent in a mode that tracks coverage (path, Whitted; not raster): image() has
-  // alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
-  bool hasAlpha() const { return transparent_ && settings_.mode != RenderMode::Raster; }
+  // --background transparent in a mode that tracks coverage (RenderModeSpec::tracksCoverage): image()
+  // has alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
+  bool hasAlpha() const { return transparent_ && renderModeSpec(settings_.mode).tracksCoverage; }
   // Tone-maps the accumulation into the rgba8 display texture (viewer).
   const GlTexture& updateDisplay(const ToneMapSettings& tone);
   const RenderStats& stats() const { return stats_; }

@@ -40,8 +40,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   scene_ = loadSceneForCli(opts, !config_.quiet, kDefaultWidth);  // every image setting, the scene's applied
   sceneName_ = fileStem(scene_.scene.path);
   RenderSettings settings = scene_.settings.render;
-  if (settings.mode == RenderMode::Raster) flattenForRaster(scene_.scene, opts, config_.quiet);
-  controls_.rasterAllowed = scene_.scene.instances.empty();  // M skips raster for an instanced scene
+  flattenForMode(scene_.scene, settings.mode, opts, config_.quiet);  // raster draws flat scenes
+  controls_.instancedScene = !scene_.scene.instances.empty();  // M skips the modes that draw flat scenes only
   controls_.wanted = settings;
   controls_.tone = scene_.settings.tone;
   controls_.stopAtTarget = config_.targetError > 0.0;
