@@ -1,4 +1,4 @@
-// gpu_scene.cpp — Scene + BVH to shader storage arrays; the emitters' light tree; feature detection.
+// gpu_scene.cpp — Scene + BVH to shader storage arrays; the emitters' light tree.
 #include "accel/gpu_scene.h"
 
 #include <cmath>
@@ -13,39 +13,6 @@
 
 namespace caustica {
 
-std::vector<std::string> SceneFeatures::defines() const {
-  std::vector<std::string> d;
-  if (mirror) d.push_back("CAUSTICA_MIRROR");
-  if (glass) d.push_back("CAUSTICA_GLASS");
-  if (volume) d.push_back("CAUSTICA_VOLUME");
-  if (dispersion) d.push_back("CAUSTICA_DISPERSION");
-  if (textures) d.push_back("CAUSTICA_TEXTURES");
-  if (opacity) d.push_back("CAUSTICA_OPACITY");
-  if (environment) d.push_back("CAUSTICA_ENV");
-  if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
-  if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
-  if (ggx) d.push_back("CAUSTICA_GGX");
-  return d;
-}
-
-std::string SceneFeatures::describe() const {
-  std::string s;
-  auto add = [&](bool on, const char* name) {
-    if (on) s += (s.empty() ? "" : " ") + std::string(name);
-  };
-  add(mirror, "mirror");
-  add(glass, "glass");
-  add(volume, "volume");
-  add(dispersion, "dispersion");
-  add(textures, "textures");
-  add(opacity, "opacity");
-  add(environment, "environment");
-  add(punctual, "punctual");
-  add(spotEmitters, "spot-emitters");
-  add(ggx, "ggx");
-  return s.empty() ? "diffuse only" : s;
-}
-
 bool hasRoughLobe(const Material& m) {
   const bool rough = m.roughness * m.roughness >= kDeltaAlpha || m.metallicRoughnessTexture >= 0;
   const bool metal = m.metallic > 0.0f || m.metallicRoughnessTexture >= 0;
@@ -54,28 +21,11 @@ bool hasRoughLobe(const Material& m) {
   return (rough && (metal || glass)) || layered;
 }
 
-SceneFeatures sceneFeatures(const Scene& scene) {
+std::vector<bool> usedMaterials(const Scene& scene) {
   std::vector<bool> used(scene.materials.size(), false);
   for (const auto& t : scene.triangles)
     if (t.material < used.size()) used[t.material] = true;
-  SceneFeatures f;
-  for (size_t i = 0; i < scene.materials.size(); ++i) {
-    if (!used[i]) continue;
-    const Material& m = scene.materials[i];
-    f.mirror |= m.metallic > 0.0f;
-    bool glass = m.transmission > 0.0f && m.metallic < 1.0f;
-    f.glass |= glass;
-    f.volume |= glass && std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f &&
-                glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
-    f.dispersion |= glass && m.dispersion > 0.0f;
-    f.textures |= m.readsTextures();
-    f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture;
-    f.ggx |= hasRoughLobe(m);
-  }
-  f.environment = scene.environment.emits() || scene.background.kind != Background::Kind::Environment;
-  f.punctual = !scene.punctualLights.empty();
-  for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
-  return f;
+  return used;
 }
 
 namespace {
@@ -83,6 +33,15 @@ std::uint32_t floatBits(float f) {
   std::uint32_t u;
   std::memcpy(&u, &f, sizeof u);
   return u;
+}
+
+// TriShade words per triangle: with full-float texcoords where a material some triangle uses reads a
+// texture (the CAUSTICA_TEXTURES row of gpu/shader_features.cpp asks the same of the materials).
+std::uint32_t triShadeStride(const Scene& scene) {
+  const std::vector<bool> used = usedMaterials(scene);
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (used[m] && scene.materials[m].readsTextures()) return gpu::kTriShadeWordsTextured;
+  return gpu::kTriShadeWords;
 }
 
 // Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, stride): its octahedral normals, then
@@ -155,8 +114,8 @@ LightTreeItem emitterItem(std::uint32_t tri, const glm::vec3* p, double power, b
   return item;
 }
 
-// What packScene and packInstancedScene share: features, environment, materials, punctual lights,
-// textures (not the triangles, the casters or the emitters).
+// What packScene and packInstancedScene share: environment, materials, punctual lights, textures
+// (not the triangles, the casters or the emitters).
 void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
   if (!scene.texcoords.empty() && scene.texcoords.size() != scene.triangles.size())
     throw Error("internal: Scene::texcoords is neither empty nor one per triangle");
@@ -193,7 +152,6 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
     gm.tex.z |= gpu::kMatSpotEmitter;
   }
   g.punctual = packPunctualLights(scene.punctualLights, scene.bounds, scene.path);
-  g.features.punctual = g.punctual.count.x > 0;
 
   for (const Texture& t : scene.textures) {
     gpu::TexInfo info{};
@@ -219,13 +177,12 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   GpuScene g;
-  g.features = sceneFeatures(scene);
   g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
   g.emitterSphere = emitterBoundingSphere(scene);
   packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triangleCount = bvh.order.size();
-  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  g.triShadeStride = triShadeStride(scene);
   packMaterialsAndTextures(scene, g);
 
   // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
@@ -253,8 +210,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
 GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   if (bvh.triSource.size() != bvh.tris.size()) throw Error("internal: packInstancedScene without triSource");
   GpuScene g;
-  g.features = sceneFeatures(scene);
-  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  g.triShadeStride = triShadeStride(scene);
   // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
   // the light-leaf table).
   std::vector<std::uint32_t> emissiveIndex(scene.triangles.size(), gpu::kInvalidIndex);

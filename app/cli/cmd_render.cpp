@@ -99,7 +99,7 @@ int cmdRender(const std::vector<std::string>& args) {
   Renderer renderer(library, ls.scene, ls.camera, settings);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
                   std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
-                  renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
+                  renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
                   (renderModeSpec(settings.mode).pathTracer ? integratorName(settings.integrator) : renderModeName(settings.mode)));
   if (resumeFrom) {

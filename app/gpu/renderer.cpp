@@ -103,6 +103,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     memTrace("wide nodes");
   }
   load_.pack = since(t0);
+  sceneFeatures_ = detectFeatures(scene, gpuScene_);
 
   GpuScene& g = gpuScene_;
   Bounds sceneBounds;
@@ -184,34 +185,12 @@ void Renderer::prepareMode() {
   }
 }
 
-namespace {
-// Every material feature define, for RenderSettings::allFeatures (the unspecialised shader).
-std::vector<std::string> allMaterialFeatureDefines() {
-  SceneFeatures f;
-  f.mirror = f.glass = f.volume = f.dispersion = f.textures = f.opacity = true;
-  f.environment = f.punctual = f.spotEmitters = f.ggx = true;
-  return f.defines();
-}
-}  // namespace
-
 std::vector<std::string> Renderer::shaderDefines() const {
-  std::vector<std::string> d = gpuScene_.features.defines();
-  const RenderModeSpec& mode = renderModeSpec(settings_.mode);
-  if (settings_.allFeatures && mode.pathTracer) d = allMaterialFeatureDefines();
+  std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_).defines();  // shader_features.cpp
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
-  if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
-  if (!mode.pathTracer) return d;  // Whitted: materials only; raster: no compute variant
-  if (settings_.integrator == Integrator::Mis && (gpuScene_.emitterCount > 0 || gpuScene_.environment.width > 0)) {
-    d.push_back("CAUSTICA_MIS");
-    if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
-    // No emissive triangles (mis for the environment alone): the emitter estimate and the emitter-hit
-    // pdf are left out rather than run masked on every bounce (llvmpipe runs every branch; vertex.glsl).
-    if (gpuScene_.emitterCount == 0 && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
-  }
-  if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
 }
 
@@ -370,8 +349,7 @@ int Renderer::samplesPerDispatch() const {
   if (renderModeSpec(settings_.mode).samples != SampleRule::Regeneration) return 1;
   const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
   int perSample = settings_.maxDepth;
-  const std::vector<std::string> defines = shaderDefines();
-  if (std::find(defines.begin(), defines.end(), "CAUSTICA_OPACITY") != defines.end()) perSample += kMaxPassThroughs;
+  if (variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
   return std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
 }
 

@@ -1,5 +1,6 @@
 // gpu_scene_test.cpp — packing for the GPU: the emitters' count and light-tree powers, material
-// conversion and feature detection, the TriShade words from the scene model's compact triangles.
+// conversion, used materials, the TriShade words from the scene model's compact triangles. (Feature
+// detection: tests/gpu/shader_features_test.cpp.)
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -60,7 +61,7 @@ TEST_CASE("emitters: one light-tree leaf per emissive triangle, power luminance 
   CHECK(leaves == g.emitterCount);
 }
 
-TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, flags, features") {
+TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, flags") {
   Scene s;
   Material glass;
   glass.transmission = 1.0f;
@@ -78,34 +79,31 @@ TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, 
   CHECK(m.absorption.w == doctest::Approx(40.0));  // V = 20 / dispersion
   CHECK((m.tex.z & gpu::kMatHasVolume) != 0u);
   CHECK((m.tex.z & gpu::kMatDispersive) != 0u);
-  CHECK(g.features.glass);
-  CHECK(g.features.volume);
-  CHECK(g.features.dispersion);
-  CHECK_FALSE(g.features.mirror);
-  CHECK_FALSE(g.features.textures);
-  CHECK(g.features.describe() == "glass volume dispersion");
 }
 
-TEST_CASE("a material no triangle uses does not switch features on") {
+TEST_CASE("a material no triangle uses is not used, and its textures add no texcoords to the TriShade words") {
   Scene s;
-  Material white, mirror;
-  mirror.metallic = 1.0f;
-  s.materials = {white, mirror};
+  Material white, textured;
+  textured.baseColorTexture = 0;
+  s.materials = {white, textured};
   s.triangles = {quadTri(1, 0, 0, false)};
-  CHECK_FALSE(sceneFeatures(s).mirror);
-  CHECK(sceneFeatures(s).defines().empty());
+  CHECK(usedMaterials(s) == std::vector<bool>{true, false});
+  CHECK(packScene(s, buildBvh(s.triangles)).triShadeStride == gpu::kTriShadeWords);
+  s.triangles.push_back(quadTri(1, 0, 1, true));
+  CHECK(usedMaterials(s) == std::vector<bool>{true, true});
+  CHECK(packScene(s, buildBvh(s.triangles)).triShadeStride == gpu::kTriShadeWordsTextured);
 }
 
-TEST_CASE("GGX materials: rough lobes switch CAUSTICA_GGX on; specular layer, data textures and shared texels are packed") {
+TEST_CASE("GGX materials: rough lobes (hasRoughLobe); specular layer, data textures and shared texels are packed") {
   Scene s;
   Material smoothMirror;
   smoothMirror.metallic = 1.0f;
   smoothMirror.roughness = 0.03f;  // alpha 9e-4 < kDeltaAlpha: still the delta mirror
   s.materials = {smoothMirror};
   s.triangles = {quadTri(1, 0, 0, false)};
-  CHECK_FALSE(packScene(s, buildBvh(s.triangles)).features.ggx);
+  CHECK_FALSE(hasRoughLobe(s.materials[0]));
   s.materials[0].roughness = 0.04f;  // alpha 1.6e-3: GGX
-  CHECK(packScene(s, buildBvh(s.triangles)).features.ggx);
+  CHECK(hasRoughLobe(s.materials[0]));
 
   Material plastic;
   plastic.specularF0 = glm::vec3(0.04f, 0.03f, 0.02f);
@@ -127,9 +125,8 @@ TEST_CASE("GGX materials: rough lobes switch CAUSTICA_GGX on; specular layer, da
   s.textures = {t, shared};
   s.materials = {plastic};
   GpuScene g = packScene(s, buildBvh(s.triangles));
-  CHECK(g.features.ggx);  // a diffuse base with a specular layer is GGX
-  CHECK(g.features.textures);
-  CHECK(g.features.opacity);  // texture alpha (MASK)
+  CHECK(hasRoughLobe(plastic));  // a diffuse base with a specular layer is GGX
+  CHECK(g.triShadeStride == gpu::kTriShadeWordsTextured);
   const gpu::Material& m = g.materials[0];
   CHECK(m.specular == glm::vec4(0.04f, 0.03f, 0.02f, 0.5f));
   CHECK(m.tex2.x == 1u);

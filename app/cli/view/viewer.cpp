@@ -68,7 +68,7 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   controller_ = std::make_unique<CameraController>(scene_.camera, scene_.scene.bounds);
   appliedRevision_ = controller_->revision();
   note(config_.quiet, scene_.scene.path + ": " + std::to_string(scene_.scene.triangles.size()) + " triangles, features: " +
-                          renderer_->gpuScene().features.describe() + "; " + std::to_string(fullW_) + "x" +
+                          renderer_->sceneFeatures().describe() + "; " + std::to_string(fullW_) + "x" +
                           std::to_string(fullH_) + ", " + integratorName(controls_.wanted.integrator) +
                           "; press H for the controls");
   double x = 0.0, y = 0.0;
