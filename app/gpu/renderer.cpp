@@ -215,6 +215,9 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   settings.validate();
   SettingsChange change = compareSettings(settings_, settings);
   if (!change.restart) return change;
+  // Another variant whenever a row of the feature table turns on or off, whichever field its settings
+  // test reads.
+  change.shader = change.shader || !(variantFeatures(sceneFeatures_, settings_) == variantFeatures(sceneFeatures_, settings));
   if (change.resize) checkImageSize(limits_, settings.width, settings.height);
   const RenderSettings previous = settings_;
   settings_ = settings;
