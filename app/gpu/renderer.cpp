@@ -197,6 +197,7 @@ std::vector<std::string> Renderer::shaderDefines() const {
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
   const char* entry = renderModeSpec(settings_.mode).entryShader;
+  if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
   std::string key = std::string(entry) + ":";
   for (const auto& d : defines) key += d + " ";
   auto it = programs_.find(key);
