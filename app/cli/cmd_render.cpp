@@ -119,7 +119,7 @@ int renderFrames(const Options& opts, const std::string& pattern, const RenderBu
                                            : path + " has " + animationsSummary(posed));
     }
     LoadedScene ls = prepareLoadedScene(std::move(posed), opts, pose, !quiet && n == first);
-    if (ls.settings.render.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, true);
+    flattenForMode(ls.scene, ls.settings.render.mode, opts, true);  // raster draws flat scenes
     const double sceneSeconds = seconds(frameStart);
     const RenderSettings& settings = ls.settings.render;
     if (!renderer) {
@@ -279,12 +279,13 @@ int cmdRender(const std::vector<std::string>& args) {
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   const RenderSettings& settings = ls.settings.render;
   const ToneMapSettings& tone = ls.settings.tone;
-  if (settings.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, quiet);  // cli_common.h
+  flattenForMode(ls.scene, settings.mode, opts, quiet);  // raster draws flat scenes (cli_common.h)
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
   note(quiet, "settings: " + settingsSummary(ls.settings));
-  if (settings.mode == RenderMode::Raster && share)
-    throw Error("--mode raster with --shard: the raster mode draws one deterministic frame, there are no samples to share");
+  if (share && renderModeSpec(settings.mode).samples == SampleRule::OneFrame)
+    throw Error(std::string("--mode ") + renderModeName(settings.mode) +
+                " with --shard: it draws one deterministic frame, there are no samples to share");
   if (resumeFrom) {
     std::string diff = checkpointMismatch(*resumeFrom, sceneHash, identity);
     if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
@@ -308,11 +309,11 @@ int cmdRender(const std::vector<std::string>& args) {
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
-                  std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
-                  renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
+                  std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
+                  renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
                   (share ? describeShare(*share) + ", " : std::string()) +
-                  (settings.mode == RenderMode::Path ? integratorName(settings.integrator) : renderModeName(settings.mode)));
+                  (renderModeSpec(settings.mode).pathTracer ? integratorName(settings.integrator) : renderModeName(settings.mode)));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);
     note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");
