@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "accel/bvh_wide.h"
 #include "accel/spawn.h"
 #include "accel/tlas.h"
