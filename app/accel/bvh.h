@@ -1,7 +1,6 @@
-// bvh.h — binned-SAH bounding volume hierarchy over triangles, flattened to the GPU layout
-// (gpu::BvhNode, 64 bytes: both children's boxes in the parent): the build (bvh_build.cpp; one subtree:
-// bvh_subtree.cpp; the split search: bvh_split.cpp) and the packed tree's triangles, bounds and cost
-// (bvh_layout.cpp). Traversal: bvh_traverse.h; the triangle test: intersect.h.
+// bvh.h — binned-SAH BVH over triangles in the GPU layout (gpu::BvhNode, 64 bytes: both children's boxes
+// in the parent): the build (bvh_build.cpp, bvh_subtree.cpp, bvh_split.cpp) and the packed tree's
+// triangles, bounds and SAH cost (bvh_layout.cpp). Traversal: bvh_traverse.h; triangle test: intersect.h.
 #pragma once
 #include <cstdint>
 #include <vector>
