@@ -169,16 +169,20 @@ class Renderer {
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
 
  private:
-  static double secondsSince(std::chrono::steady_clock::time_point t);
-  // Everything of the scene on the GPU: BVH, packed arrays, buffers and their views, UBOs, the
-  // environment (what the constructor and setScene share).
-  void uploadScene(const Scene& scene);
   const GlProgram& program();
   void prepareMode();  // compiles the current mode's compute variant, or builds the raster pipeline
   void allocateImages();
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
+  // The constructor's steps, in order; setScene repeats loadScene's.
+  void checkLimits();                      // the GL context's limits and the settings
+  void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
+  std::vector<gpu::BvhWideNode> buildScene(const Scene& scene);  // BVH and GpuScene; flat: the 4-wide nodes
+  void planBuffers(const Scene& scene);    // binary nodes cut to the root (flat), the storage blocks' plan
+  void uploadScene(const Scene& scene, std::vector<gpu::BvhWideNode> wideNodes);  // buffers and textures
+  void createUniformBuffers();             // frame, casters, punctual lights
+  void uploadLights(const Scene& scene, const Bounds& sceneBounds);  // point lights, environment
 
   const ShaderLibrary& library_;
   RendererOptions options_;
