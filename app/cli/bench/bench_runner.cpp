@@ -198,7 +198,7 @@ class BenchRunner {
     auto tiles = [&](int tile) { return tileRelVariance(st.accum, st.comp, st.half, ref.image, tile); };
     const std::vector<double> v4 = tiles(4);
     {  // per pixel (row-major): the per-sample relative variance, reference-weighted, from the halves, for
-       // analyses across renders (scripts/adaptive-ceiling; docs/benchmarks.md, "Adaptive sampling")
+       // analyses across renders (bench/experiments/adaptive-ceiling; docs/adaptive-sampling.md, "How much it can gain")
       std::ofstream f(outDir_ + "/" + name + "-" + dispersionModeName(mode) + "-pixel-variance.txt");
       f << "# " << ref.image.width << "x" << ref.image.height << " pixels, row-major: per-sample relative variance "
         << "from the halves (uniform render, seed " << run.seed << ", " << spp << " spp)\n";
