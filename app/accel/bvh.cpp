@@ -486,7 +486,7 @@ Bvh buildBvhOnce(const Triangle* triangles, std::size_t count, const BvhBuildOpt
 Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options) {
   Bvh bvh = buildBvhOnce(triangles, count, options);
   // Small meshes: a second build with other bins, kept when its SAH cost is lower (binned SAH splits
-  // greedily top-down, so more bins can make a worse tree: docs/benchmarks.md, "Session 7").
+  // greedily top-down, so more bins can make a worse tree: docs/architecture.md, "BVH build").
   if (options.secondBins > 0 && options.secondBins != options.bins && count < options.secondBinsBelow) {
     BvhBuildOptions o = options;
     o.bins = options.secondBins;
@@ -823,7 +823,7 @@ bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const
   const float det = e0 + e1 + e2;
   if (det == 0.0f) return false;  // ray in the triangle's plane
   // Zero-area triangles can pass the test above once their vertices are rounded in ray space (in a
-  // scratch search the t error bound below then rejected every one, docs/benchmarks.md "Session 7",
+  // scratch search the t error bound below then rejected every one, docs/architecture.md "Traversal",
   // but that is not proven). The GLSL twin has no such check: packedTrianglePositions stores them as
   // one point, which det == 0 rejects; this check keeps the reference right for any vertices.
   if (isZeroAreaTriangle(p0, p1, p2)) return false;

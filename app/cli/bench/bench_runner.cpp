@@ -211,7 +211,8 @@ class BenchRunner {
     // The allocation adaptive sampling itself makes (AdaptiveSampler, this tile size and guards, another
     // seed: independent of the variances), run to a mean of min(spp01, spp) samples per pixel; its
     // expected relMSE mean(v / n) against uniform sampling's mean(v) / mean(n). Free of a single run's
-    // luck, which favours adaptive sampling where noise is heavy-tailed (docs/benchmarks.md).
+    // luck, which favours adaptive sampling where noise is heavy-tailed (docs/adaptive-sampling.md, "How much
+    // it can gain").
     AdaptiveSampler sampler(0.0, true);
     const std::vector<double> vt = sampler.tileSize() == 4 ? v4 : tiles(sampler.tileSize());  // v4 at the default
     RenderSettings other = run;
