@@ -56,7 +56,7 @@ struct RenderSettings {
   bool operator!=(const RenderSettings& o) const { return !(*this == o); }
 };
 
-// What a setting changes, for visitFields' users (docs/long-renders.md, "What must match"):
+// What a setting changes, for visitFields' users (docs/long-renders.md, "Resuming": what must match):
 enum class SettingRole {
   // The samples themselves (their expectation or their random streams): part of the accumulation
   // identity, which two renders must share to add their samples (resume, shards, merge).
