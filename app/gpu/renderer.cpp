@@ -103,6 +103,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     memTrace("wide nodes");
   }
   load_.pack = since(t0);
+  sceneFeatures_ = detectFeatures(scene, gpuScene_);
 
   GpuScene& g = gpuScene_;
   Bounds sceneBounds;
@@ -171,11 +172,12 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
 }
 
 void Renderer::prepareMode() {
-  if (settings_.mode != RenderMode::Raster) {
+  const RenderModeSpec& mode = renderModeSpec(settings_.mode);
+  if (!mode.instancedScenes && gpuScene_.instanceCount > 0)
+    throw Error(std::string(mode.name) + " mode draws flattened scenes only: load this scene with --instances off");
+  if (mode.entryShader) {
     program();
   } else if (!raster_) {
-    if (gpuScene_.instanceCount > 0)
-      throw Error("raster mode draws flattened scenes only: load this scene with --instances off");
     downloadSceneArrays(gpuScene_, bufferLayout_, buffers_);  // the raster mesh is built from them
     raster_ = std::make_unique<RasterRenderer>(library_, gpuScene_, pointLights_);
     std::vector<gpu::TriGeom>().swap(gpuScene_.triGeom);
@@ -183,39 +185,19 @@ void Renderer::prepareMode() {
   }
 }
 
-namespace {
-// Every material feature define, for RenderSettings::allFeatures (the unspecialised shader).
-std::vector<std::string> allMaterialFeatureDefines() {
-  SceneFeatures f;
-  f.mirror = f.glass = f.volume = f.dispersion = f.textures = f.opacity = true;
-  f.environment = f.punctual = f.spotEmitters = f.ggx = true;
-  return f.defines();
-}
-}  // namespace
-
 std::vector<std::string> Renderer::shaderDefines() const {
-  std::vector<std::string> d = gpuScene_.features.defines();
-  if (settings_.allFeatures && settings_.mode == RenderMode::Path) d = allMaterialFeatureDefines();
+  std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_).defines();  // shader_features.cpp
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
-  if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
-  if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
-  if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
-    d.push_back("CAUSTICA_MIS");
-    if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
-    // No emissive triangles (mis for the environment alone): the emitter estimate and the emitter-hit
-    // pdf are left out rather than run masked on every bounce (llvmpipe runs every branch; vertex.glsl).
-    if (gpuScene_.emitters.empty() && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
-  }
-  if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
 }
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
-  const char* entry = settings_.mode == RenderMode::Whitted ? "whitted.comp" : "pathtrace.comp";
+  const char* entry = renderModeSpec(settings_.mode).entryShader;
+  if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
   std::string key = std::string(entry) + ":";
   for (const auto& d : defines) key += d + " ";
   auto it = programs_.find(key);
@@ -234,6 +216,9 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   settings.validate();
   SettingsChange change = compareSettings(settings_, settings);
   if (!change.restart) return change;
+  // Another variant whenever a row of the feature table turns on or off, whichever field its settings
+  // test reads.
+  change.shader = change.shader || !(variantFeatures(sceneFeatures_, settings_) == variantFeatures(sceneFeatures_, settings));
   if (change.resize) checkImageSize(limits_, settings.width, settings.height);
   const RenderSettings previous = settings_;
   settings_ = settings;
@@ -299,9 +284,9 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   y0 = std::max(0, y0);
   y1 = std::min(settings_.height, y1);
   if (y1 <= y0 || spp <= 0) return;
-  if (settings_.mode == RenderMode::Raster) {
-    // One deterministic frame drawn straight into the accumulation image (alpha = 1 sample), once
-    // per restart: later passes would only draw the same frame again.
+  if (!renderModeSpec(settings_.mode).entryShader) {
+    // The raster pipeline: one deterministic frame drawn straight into the accumulation image (alpha
+    // = 1 sample), once per restart (SampleRule::OneFrame): later passes would only draw it again.
     if (spp_ == 0 && y0 == 0) {
       prepareMode();
       pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
@@ -314,7 +299,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
 }
 
 void Renderer::renderPass(int spp) {
-  if (tileListActive_ && settings_.mode != RenderMode::Raster) {  // raster: one frame, no samples to spread
+  if (tileListActive_ && renderModeSpec(settings_.mode).samples != SampleRule::OneFrame) {  // one frame: no samples to spread
     if (liveTiles_ > 0 && spp > 0) dispatchSamples(spp, 0, settings_.height, true);
   } else {
     renderRows(0, settings_.height, spp);
@@ -365,11 +350,10 @@ constexpr int kMaxPassThroughs = 256;          // path_state.glsl's kMaxPassThro
 }  // namespace
 
 int Renderer::samplesPerDispatch() const {
-  if (settings_.mode != RenderMode::Path) return 1;  // whitted.comp traces one sample per dispatch
+  if (renderModeSpec(settings_.mode).samples != SampleRule::Regeneration) return 1;
   const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
   int perSample = settings_.maxDepth;
-  const std::vector<std::string> defines = shaderDefines();
-  if (std::find(defines.begin(), defines.end(), "CAUSTICA_OPACITY") != defines.end()) perSample += kMaxPassThroughs;
+  if (variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
   return std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
 }
 
@@ -429,7 +413,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
       sinceRead = 0;
     }
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), std::uint32_t(k));
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), std::uint32_t(k));
     frameUbo_.update(0, sizeof fp, &fp);
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);

@@ -168,7 +168,7 @@ TEST_CASE("instancing: 64 instances of a sphere keep one sphere on the GPU") {
   CHECK(r.gpuScene().instanceCount == 65);
   CHECK(r.gpuScene().instancedTriangles == 64 * sphere + 2);
   CHECK(r.gpuBytes().triGeom == (sphere + 2) * sizeof(gpu::TriGeom));
-  CHECK(r.gpuScene().emitters.size() == 2);
+  CHECK(r.gpuScene().emitterCount == 2);
   r.renderPass(4);
   CHECK(meanOf(r.image()) > 0.0);
 }

@@ -99,8 +99,9 @@ bool hasDefineStartingWith(const std::vector<std::string>& d, const std::string&
 
 TEST_CASE("scene buffers: a scene split over several storage blocks renders the same image, bit for bit") {
   const Scene scene = splitScene();
-  for (RenderMode mode : {RenderMode::Path, RenderMode::Whitted, RenderMode::Raster}) {
-    const std::string modeName = renderModeName(mode);
+  for (const RenderModeSpec& spec : renderModes()) {
+    const RenderMode mode = spec.mode;
+    const std::string modeName = spec.name;
     CAPTURE(modeName);
     const SplitRender whole = render(scene, mode, 8);
     CHECK(whole.layout.extraBlocks() == 0);
