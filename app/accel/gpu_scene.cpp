@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "accel/intersect.h"
 #include "accel/tlas.h"
 #include "scene/caustic_casters.h"
 #include "util/error.h"

@@ -65,8 +65,50 @@ gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const s
 
 Renderer::~Renderer() = default;
 
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// World-space bounds of everything in the binary tree (empty for an empty tree).
+Bounds treeBounds(const std::vector<gpu::BvhNode>& nodes) {
+  Bounds b;
+  glm::vec3 lo, hi;
+  if (bvhBounds(nodes, lo, hi)) {
+    b.grow(lo);
+    b.grow(hi);
+  }
+  return b;
+}
+
+}  // namespace
+
 Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
     : library_(library), settings_(settings), camera_(camera) {
+  checkLimits();
+  created_ = std::chrono::steady_clock::now();
+  memTrace("renderer start");
+  std::vector<gpu::BvhWideNode> wideNodes = buildScene(scene);
+  const Bounds sceneBounds = treeBounds(gpuScene_.nodes);
+  planBuffers(scene);
+  const auto t0 = std::chrono::steady_clock::now();
+  uploadScene(scene, std::move(wideNodes));
+  createUniformBuffers();
+  uploadLights(scene, sceneBounds);
+  glFinish();
+  load_.upload = secondsSince(t0);
+  memTrace("upload done");
+  transparent_ = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
+  allocateImages();
+  const auto t1 = std::chrono::steady_clock::now();
+  prepareMode();  // compile now, so shader errors surface before rendering starts
+  load_.compile = secondsSince(t1);
+  memTrace("compiled");
+  load_.ready = secondsSince(created_);
+}
+
+void Renderer::checkLimits() {
   limits_ = queryGlLimits();
   if (limits_.maxComputeStorageBlocks < CAUSTICA_SSBO_COUNT)
     throw Error("this GPU allows " + std::to_string(limits_.maxComputeStorageBlocks) +
@@ -75,17 +117,14 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     throw Error("this GPU's compute work groups are too small");
   settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
-  created_ = std::chrono::steady_clock::now();
-  const auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
+}
+
+std::vector<gpu::BvhWideNode> Renderer::buildScene(const Scene& scene) {
   auto t0 = std::chrono::steady_clock::now();
-  const bool instanced = !scene.instances.empty();
-  memTrace("renderer start");
   std::vector<gpu::BvhWideNode> wideNodes;  // what traverse.glsl reads in flat scenes
-  if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
+  if (!scene.instances.empty()) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
     InstancedBvh ib = buildInstancedBvh(scene);
-    bvhSeconds_ = load_.bvh = since(t0);
+    bvhSeconds_ = load_.bvh = secondsSince(t0);
     bvh_.depth = ib.depth;
     t0 = std::chrono::steady_clock::now();
     gpuScene_ = packInstancedScene(scene, ib);
@@ -93,7 +132,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     const BvhShape shape = bvhShapeFromEnv();
     bvh_ = buildBvh(scene.triangles, shape.build);
     memTrace("bvh built");
-    bvhSeconds_ = load_.bvh = since(t0);
+    bvhSeconds_ = load_.bvh = secondsSince(t0);
     t0 = std::chrono::steady_clock::now();
     std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
     bvh_.nodes.clear();
@@ -102,27 +141,27 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     wideNodes = packBvhWideNodes(gpuScene_.nodes, shape.collapse).nodes;
     memTrace("wide nodes");
   }
-  load_.pack = since(t0);
+  load_.pack = secondsSince(t0);
   sceneFeatures_ = detectFeatures(scene, gpuScene_);
+  return wideNodes;
+}
 
+void Renderer::planBuffers(const Scene& scene) {
   GpuScene& g = gpuScene_;
-  Bounds sceneBounds;
-  glm::vec3 bvhLo, bvhHi;
-  if (bvhBounds(g.nodes, bvhLo, bvhHi)) {
-    sceneBounds.grow(bvhLo);
-    sceneBounds.grow(bvhHi);
-  }
   // Flat scenes trace through the 4-wide nodes only (traverse.glsl), so the binary node buffer keeps
   // just the root there (~32 B per triangle less on the GPU). Instanced scenes trace the binary
   // two-level BVH (nodes, then instance records) and get an empty wide tree.
-  if (!instanced) {  // released, not only resized: the binary nodes' memory is free before the upload
+  if (scene.instances.empty()) {  // released, not only resized: the binary nodes' memory is free before the upload
     std::vector<gpu::BvhNode> root(g.nodes.begin(), g.nodes.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(g.nodes.size()), 1));
     g.nodes.swap(root);
   }
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
+}
+
+void Renderer::uploadScene(const Scene& scene, std::vector<gpu::BvhWideNode> wideNodes) {
+  GpuScene& g = gpuScene_;
   gpuBytes_.nodes += wideNodes.size() * sizeof(gpu::BvhWideNode);
-  t0 = std::chrono::steady_clock::now();
   // The 4-wide nodes go up first and their host copy is freed before the triangle records' blocks are
   // made, so the two copies of the nodes and the triangle blocks are never held at once (on llvmpipe
   // the "GPU" copy is host memory: docs/big-scenes.md).
@@ -145,11 +184,17 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
+}
+
+void Renderer::createUniformBuffers() {
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
-  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
+  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &gpuScene_.punctual, GL_STATIC_DRAW);
   uploadCasters();
-  if (instanced) {  // the point lights of Whitted and raster: from world-space copies of the emissive meshes
+}
+
+void Renderer::uploadLights(const Scene& scene, const Bounds& sceneBounds) {
+  if (!scene.instances.empty()) {  // the point lights of Whitted and raster: from world-space copies of the emissive meshes
     std::vector<bool> emissive(scene.materials.size());
     for (std::size_t m = 0; m < scene.materials.size(); ++m) emissive[m] = scene.materials[m].isEmissive();
     lightGroups_ = groupEmitters(flattenedSubset(scene, emissive), CAUSTICA_MAX_POINT_LIGHTS);
@@ -158,17 +203,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   }
   pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
-  environment_.upload(g, limits_, scene.path);
-  glFinish();
-  load_.upload = since(t0);
-  memTrace("upload done");
-  transparent_ = g.environmentParams.size.z == gpu::kBackgroundTransparent;
-  allocateImages();
-  t0 = std::chrono::steady_clock::now();
-  prepareMode();  // compile now, so shader errors surface before rendering starts
-  load_.compile = since(t0);
-  memTrace("compiled");
-  load_.ready = since(created_);
+  environment_.upload(gpuScene_, limits_, scene.path);
 }
 
 void Renderer::prepareMode() {

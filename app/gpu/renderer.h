@@ -132,6 +132,13 @@ class Renderer {
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
+  // The constructor's steps, in order.
+  void checkLimits();                      // the GL context's limits and the settings
+  std::vector<gpu::BvhWideNode> buildScene(const Scene& scene);  // BVH and GpuScene; flat: the 4-wide nodes
+  void planBuffers(const Scene& scene);    // binary nodes cut to the root (flat), the storage blocks' plan
+  void uploadScene(const Scene& scene, std::vector<gpu::BvhWideNode> wideNodes);  // buffers and textures
+  void createUniformBuffers();             // frame, casters, punctual lights
+  void uploadLights(const Scene& scene, const Bounds& sceneBounds);  // point lights, environment
 
   const ShaderLibrary& library_;
   RenderSettings settings_;
