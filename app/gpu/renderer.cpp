@@ -420,7 +420,7 @@ namespace {
 // a furnace, depth 1024) check to lose no energy, so K samples get that bound and no more.
 constexpr int kRegenBounceBudget = 1024;
 constexpr int kDefaultSamplesPerDispatch = 4;  // docs/benchmarks.md, "Path regeneration"
-constexpr int kMaxPassThroughs = 256;          // pathtrace.comp's kMaxPassThroughs
+constexpr int kMaxPassThroughs = 256;          // path_state.glsl's kMaxPassThroughs
 }  // namespace
 
 int Renderer::samplesPerDispatch() const {

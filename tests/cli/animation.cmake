@@ -20,7 +20,7 @@ function(identical a b)
   endif()
 endfunction()
 
-# A key time equals the static scene with that pose (make_animated_gltf.py writes both files).
+# A key time equals the static scene with that pose (make-animated-gltf writes both files).
 run(0 ${DATA}/trs.gltf ${COMMON} -q --anim-time 1 -o ${DIR}/trs-t1.exr)
 run(0 ${DATA}/trs-at-1.gltf ${COMMON} -q -o ${DIR}/trs-static.exr)
 identical(${DIR}/trs-t1.exr ${DIR}/trs-static.exr)

@@ -35,7 +35,7 @@ glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& axis, double degrees) {
   return v * c + glm::cross(axis, v) * s + axis * glm::dot(axis, v) * (1.0 - c);
 }
 
-// The unit cube's 36 corners as the loader stores its 12 triangles (make_animated_gltf.py's cube()).
+// The unit cube's 36 corners as the loader stores its 12 triangles (make-animated-gltf's cube()).
 std::vector<glm::dvec3> cubeCorners() {
   std::vector<glm::dvec3> out;
   for (int axis = 0; axis < 3; ++axis)
@@ -156,7 +156,7 @@ TEST_CASE("animation: rotations slerp along the shorter arc and stay unit") {
 }
 
 TEST_CASE("animation: trs.gltf's nodes and camera at several times, against T * R * S by hand") {
-  // Triangles in node order: floor (2), cube (12), box (12). Animation "move" (make_animated_gltf.py).
+  // Triangles in node order: floor (2), cube (12), box (12). Animation "move" (make-animated-gltf).
   {
     const Scene s = load("trs.gltf", 0.5);
     REQUIRE(s.triangles.size() == 26);
