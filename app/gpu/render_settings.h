@@ -96,6 +96,7 @@ static_assert(fieldCount<RenderSettings>() == 10, "RenderSettings has a field th
 std::string settingText(int v);
 std::string settingText(std::uint32_t v);
 std::string settingText(float v);
+std::string settingText(double v);
 std::string settingText(bool v);  // "on" | "off"
 std::string settingText(const std::string& v);
 std::string settingText(Integrator v);
