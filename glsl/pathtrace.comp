@@ -122,10 +122,6 @@ void main() {
     while (true) {
       if (path.depth < maxDepth && pathBounce(path)) continue;
       vec3 l = path.radiance;
-#ifdef CAUSTICA_MANIFOLD_DEBUG
-      l = gDebug;
-      gDebug = vec3(0.0);
-#endif
       bool finite = !(any(isnan(l)) || any(isinf(l)));
       if (!finite) ++bad;  // counted and reported; not part of the pixel's mean (neither as black)
       addSample(sums, finite ? l : vec3(0.0), finite ? 1.0 : 0.0);

@@ -21,17 +21,6 @@ DispersionMode parseDispersionMode(const std::string& name) {
   throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
 }
 
-RenderMode parseRenderMode(const std::string& name) {
-  if (name == "path") return RenderMode::Path;
-  if (name == "whitted") return RenderMode::Whitted;
-  if (name == "raster") return RenderMode::Raster;
-  throw Error("unknown render mode '" + name + "' (expected path, whitted or raster)");
-}
-
-const char* renderModeName(RenderMode m) {
-  return m == RenderMode::Path ? "path" : m == RenderMode::Whitted ? "whitted" : "raster";
-}
-
 const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
 const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
 
@@ -66,6 +55,11 @@ std::string settingText(int v) { return std::to_string(v); }
 std::string settingText(std::uint32_t v) { return std::to_string(v); }
 std::string settingText(float v) {
   char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // the shortest text that reads back as v
+  return std::string(buf, r.ptr);
+}
+std::string settingText(double v) {
+  char buf[40];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);  // the shortest text that reads back as v
   return std::string(buf, r.ptr);
 }

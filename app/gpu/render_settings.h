@@ -6,17 +6,13 @@
 #include <string>
 #include <type_traits>
 
+#include "gpu/render_mode.h"  // RenderMode: one row per mode
 #include "util/field_count.h"
 
 namespace caustica {
 
 enum class Integrator { Naive, Mis };
 enum class DispersionMode { Rgb, Spectral };
-// How the image is made (docs/render-modes.md): the path tracer, a Whitted ray tracer (compute
-// shader, point lights, mirrors and glass, no global illumination) or the OpenGL raster pipeline.
-enum class RenderMode { Path, Whitted, Raster };
-RenderMode parseRenderMode(const std::string& name);          // "path" | "whitted" | "raster"; throws Error otherwise
-const char* renderModeName(RenderMode m);
 Integrator parseIntegrator(const std::string& name);          // "naive" | "mis"; throws Error otherwise
 DispersionMode parseDispersionMode(const std::string& name);  // "rgb" | "spectral"; throws Error otherwise
 const char* integratorName(Integrator i);
@@ -42,12 +38,12 @@ struct RenderSettings {
   float casterProbability = 0.5f;
   // mis only: manifold next-event estimation, which joins the light sample at a path's first diffuse
   // vertex to it through a glass or mirror caster (docs/path-tracer.md); scenes without casters or
-  // emitters never use it.
-  bool manifold = true;
+  // emitters never use it. Off by default until it measures faster (docs/path-tracer.md).
+  bool manifold = false;
   RenderMode mode = RenderMode::Path;
   // Compile every material feature into the path tracer, whatever the scene uses (the shader is
   // otherwise specialised to the scene's features): measures what specialisation saves
-  // (docs/benchmarks.md). The expected image does not change.
+  // (docs/benchmarks.md, "Specialisation"). The expected image does not change.
   bool allFeatures = false;
   // Samples per pixel one path-tracing dispatch traces (path regeneration, pathtrace.comp): 0 chooses
   // automatically; any value is lowered to what keeps llvmpipe's loop cap out of reach for the depth
@@ -60,7 +56,7 @@ struct RenderSettings {
   bool operator!=(const RenderSettings& o) const { return !(*this == o); }
 };
 
-// What a setting changes, for visitFields' users (docs/long-renders.md, "What must match"):
+// What a setting changes, for visitFields' users (docs/long-renders.md, "Resuming": what must match):
 enum class SettingRole {
   // The samples themselves (their expectation or their random streams): part of the accumulation
   // identity, which two renders must share to add their samples (resume, shards, merge).
@@ -105,6 +101,7 @@ static_assert(fieldCount<RenderSettings>() == 11, "RenderSettings has a field th
 std::string settingText(int v);
 std::string settingText(std::uint32_t v);
 std::string settingText(float v);
+std::string settingText(double v);
 std::string settingText(bool v);  // "on" | "off"
 std::string settingText(const std::string& v);
 std::string settingText(Integrator v);

@@ -6,9 +6,6 @@
 // estimation"). World space; directions unit; pdfs per steradian at x unless said. C++ twins of the
 // arithmetic in app/shading/manifold.h. Needs surface.glsl, casters.glsl, lights.glsl, path_state.glsl.
 
-#ifdef CAUSTICA_MANIFOLD_DEBUG
-uint gDebugIter = 0u;
-#endif
 const uint kManifoldIterations = 10u;         // Newton steps (each traces the chain once) before giving up
 const float kManifoldTolerance = 1.0e-5;      // converged: the chain ends this close to y, relative to |v_k - y|
 const float kManifoldSameSolution = 1.0e-3;   // a bounce is the solution's path: direction parameters this close
@@ -294,8 +291,5 @@ ManifoldResult manifoldSolve(ManifoldQuery q, bool wanted) {
       stepScale *= 0.5;
     }
   } while (++it < kManifoldIterations);
-#ifdef CAUSTICA_MANIFOLD_DEBUG
-  gDebugIter = it;
-#endif
   return res;
 }

@@ -6,9 +6,6 @@
 // vertex.glsl, manifold.glsl.
 
 // PathState.chain: what the path did after x, its first diffuse vertex.
-#ifdef CAUSTICA_MANIFOLD_DEBUG
-vec3 gDebug = vec3(0.0);
-#endif
 const uint kChainActive = 0x100u;    // x was recorded (PathState.mx...)
 const uint kChainDead = 0x200u;      // something other than one caster's specular events followed x
 const uint kChainOwnerMask = 0xffu;  // the caster owning the first event after x; kChainNoOwner before it
@@ -112,15 +109,7 @@ bool addManifoldLight(inout PathState s, Surface sf, bool diffuse, bool firstDif
   q.uLambda = uLambda;
   q.seed = vec2(0.0);
   bool check = gManifoldCheck && casterCount(counts, caster) > 0u;
-#ifdef CAUSTICA_MANIFOLD_OFF
-  nee = false;
-  check = false;
-#endif
   ManifoldResult r = manifoldSolve(q, nee || check);
-#ifdef CAUSTICA_MANIFOLD_DEBUG
-  if (CAUSTICA_MANIFOLD_DEBUG == 2 && nee) gDebug += r.ok ? vec3(0, 1, 0) : vec3(1, 0, 0);
-  if (CAUSTICA_MANIFOLD_DEBUG == 3 && nee) gDebug += vec3(float(gDebugIter)/12.0);
-#endif
   float pickProb = float(casterCount(counts, caster)) / max(casterCountSum(counts), 1.0);
   if (nee && r.ok) {
     LightSample ls = gManifoldLight;
@@ -140,9 +129,6 @@ bool addManifoldLight(inout PathState s, Surface sf, bool diffuse, bool firstDif
         le *= spotEmitterFactor(materialAt(ls.material), -r.dLast);
 #endif
         s.radiance += s.beta * s.filt * r.filt * f * r.throughput * le * (w / pdfMan);
-#ifdef CAUSTICA_MANIFOLD_DEBUG
-        gDebug += s.beta * s.filt * r.filt * f * r.throughput * le * (w / pdfMan);
-#endif
       }
     }
   }

@@ -39,7 +39,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_TEXUNIT_TRI_GEOM 3    // texture unit: buffer texture (rgba32ui) over the TriGeom buffer, 3 texels per triangle
 #define CAUSTICA_TEXUNIT_BVH_WIDE 6    // texture unit: buffer texture (rgba32ui) over the BvhWideNode buffer, 7 texels per node
 // The shading reads go through buffer textures too (app/gpu/shading_textures.*): on llvmpipe a texelFetch
-// is a vector gather, an SSBO load a loop over the SIMD lanes (docs/benchmarks.md, "Session 5").
+// is a vector gather, an SSBO load a loop over the SIMD lanes (docs/architecture.md, "Writing shaders for llvmpipe").
 #define CAUSTICA_TEXUNIT_MATERIALS 4   // texture unit: buffer texture (rgba32ui) over the materials buffer, 7 texels per Material
 #define CAUSTICA_TEXUNIT_LIGHT_NODES 5 // texture unit: buffer texture (rgba32ui) over the light-tree buffer, 4 texels per LightNode
 #define CAUSTICA_TEXUNIT_TEXELS 7      // texture unit: buffer texture (r32ui) over the texel buffer, one word per texel
@@ -190,14 +190,6 @@ struct Material {
                       // w: alpha cutoff (both float bits)
 };
 
-// One alias-table slot over emissive triangles (16 bytes).
-struct Emitter {
-  uint tri;         // triangle index (in TriGeom order)
-  float prob;       // probability of choosing this slot's own triangle when the slot is picked
-  uint alias;       // slot whose triangle is taken otherwise
-  float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
-};
-
 // A texture inside the texel SSBO (48 bytes, stored as kTexInfoWords uints at the head of that SSBO).
 // Several may share texels (KHR_texture_transform).
 struct TexInfo {
@@ -222,7 +214,6 @@ struct Counters {
 // One node of the light tree over the emissive triangles (64 bytes; app/accel/light_tree.h,
 // glsl/lib/light_tree.glsl): a binary BVH whose nodes bound the position, power and emission
 // directions of their triangles (Conty Estevez & Kulla 2018). Node 0 is the root; one triangle per leaf.
-// (Emitter above is the former alias-table slot, unused since the light tree.)
 struct LightNode {
   vec4 boundsMin;  // xyz: world-space AABB minimum; w: power (sum of luminance(emission) * area * sides)
   vec4 boundsMax;  // xyz: world-space AABB maximum; w: cos(theta_o), the normal cone's half angle
@@ -331,7 +322,6 @@ static_assert(sizeof(InstanceRecord) == 64, "InstanceRecord must be 64 bytes (4 
 static_assert(sizeof(InstanceShade) == 64, "InstanceShade must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
-static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
 static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
