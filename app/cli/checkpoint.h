@@ -23,11 +23,14 @@ constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
 // (--background transparent).
 // 4: the settings text is the accumulation identity (every Accumulation field of ImageSettings, one
 // "key value" a line); older files are refused, naming the file: their settings text lacks fields.
-constexpr int kCheckpointVersion = 4;
+// 5: adds a "features 1" header line and the denoiser's two rgba32f feature-sum images after the others
+// (render --denoise, --aov; docs/denoising.md). A render without feature buffers still writes version 4.
+constexpr int kCheckpointVersion = 5;
+constexpr int kCheckpointVersionWithoutFeatures = 4;
 constexpr int kCheckpointOldestVersion = 4;
 
 struct Checkpoint {
-  AccumulationState state;        // the three rgba32f images (+ coverage), spp and the next global sample index
+  AccumulationState state;        // the three rgba32f images (+ coverage, + feature sums), spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
   std::string identity;           // accumulationIdentity(settings, camera) of the render

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 
+#include "cli/aov_output.h"
 #include "cli/bench/reference_cache.h"
 #include "cli/budget_render.h"
 #include "cli/checkpoint.h"
@@ -36,6 +37,10 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--checkpoint-file", "", "FILE", "where checkpoints go (default OUTPUT.ckpt)"},
       {"--resume", "", "CHECKPOINT",
        "continue the render saved in CHECKPOINT (same scene and settings; --spp is the new total)"},
+      {"--denoise", "", "", "write the denoised image instead of the raw mean (docs/denoising.md)"},
+      {"--aov", "", "LIST",
+       "also write albedo, normal, depth, variance, raw (or all): layers of an .exr output, else files "
+       "OUTPUT-STEM.NAME.pfm (raw: the output's format) beside it"},
   };
   for (auto& s : sceneOptionSpecs()) specs.push_back(s);
   Options opts("caustica render [SCENE] [options]",
@@ -69,9 +74,17 @@ int cmdRender(const std::vector<std::string>& args) {
   const std::string checkpointFile = opts.get("--checkpoint-file", out + ".ckpt");
   checkWritableFile(out, "output");
   checkWritableFile(checkpointFile, "checkpoint");
+  const bool denoise = opts.has("--denoise");
+  const std::vector<Aov> aovs = opts.has("--aov") ? parseAovList(opts.get("--aov", "")) : std::vector<Aov>{};
+  for (const std::string& f : aovFiles(out, aovs)) checkWritableFile(f, "--aov");
   std::optional<Checkpoint> resumeFrom;
   const std::string resumePath = opts.get("--resume", "");
   if (opts.has("--resume")) resumeFrom = readCheckpoint(resumePath);  // a bad file fails before any work
+  // The feature buffers: for the denoiser and --aov, and kept going when the checkpoint has them.
+  const bool features = denoise || aovsNeedFeatures(aovs) || (resumeFrom && resumeFrom->state.hasFeatures());
+  if (resumeFrom && features && !resumeFrom->state.hasFeatures())
+    throw Error(resumePath + ": has no feature sums (it was rendered without --denoise or --aov): resume it without "
+                "--denoise and --aov, or render again with them");
 
   memTrace("command start");
   const auto commandStart = std::chrono::steady_clock::now();
@@ -82,6 +95,9 @@ int cmdRender(const std::vector<std::string>& args) {
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   const RenderSettings& settings = ls.settings.render;
   const ToneMapSettings& tone = ls.settings.tone;
+  if (features && settings.mode != RenderMode::Path)
+    throw Error(std::string(denoise ? "--denoise" : "--aov") + " needs the path tracer (--mode path), not --mode " +
+                renderModeName(settings.mode));
   if (settings.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, quiet);  // cli_common.h
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
@@ -97,6 +113,7 @@ int cmdRender(const std::vector<std::string>& args) {
   ShaderLibrary library = shaderLibraryFrom(opts);
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
+  renderer.setFeatureBuffers(features);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
                   std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
                   renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
@@ -131,7 +148,18 @@ int cmdRender(const std::vector<std::string>& args) {
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
   note(quiet, loadSummary(renderer, parseSeconds, startToRenderer, ls.scene.triangles.size()));  // load_report.h
-  writeImage(out, renderer.image(), tone);
+  {
+    const Image raw = renderer.image();
+    if (denoise) {
+      const Image denoised = renderer.denoisedImage();
+      char ms[64];
+      std::snprintf(ms, sizeof ms, "denoised in %.1f ms", renderer.denoiseMs());
+      note(quiet, ms);
+      writeImageWithAovs(out, denoised, tone, aovs, raw, aovsNeedFeatures(aovs) ? renderer.saveAccumulation() : AccumulationState{});
+    } else {
+      writeImageWithAovs(out, raw, tone, aovs, raw, aovsNeedFeatures(aovs) ? renderer.saveAccumulation() : AccumulationState{});
+    }
+  }
   {
     const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);
     note(quiet, "stats " + json);

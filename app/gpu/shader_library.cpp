@@ -92,6 +92,7 @@ const std::vector<std::string>& shaderFeatureNames() {
       "CAUSTICA_SPECTRAL",    // dispersion by hero wavelengths (else one RGB channel per path)
       "CAUSTICA_GGX",         // GGX lobes: rough metal, rough glass, specular layer over diffuse
       "CAUSTICA_ENV",         // an environment light or a background colour (environment.glsl)
+      "CAUSTICA_AOV",         // the denoiser's feature buffers (feature_buffers.glsl; render --denoise, --aov, view)
   };
   return names;
 }

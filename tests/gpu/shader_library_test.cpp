@@ -87,7 +87,7 @@ TEST_CASE("include cycles expand each file once; missing files and #version line
 }
 
 TEST_CASE("pathtrace.comp compiles with every combination of up to 3 features, and all but up to 2 (glslang, GLSL 4.30 core)") {
-  // The full cross product (2^11 variants) takes minutes; every feature is an #ifdef block, so what can
+  // The full cross product (2^12 variants) takes minutes; every feature is an #ifdef block, so what can
   // break is how up to a few of them meet: every triple, and every set missing at most two features
   // (the dense variants real scenes use), covers that.
   ShaderLibrary lib;
@@ -167,6 +167,11 @@ TEST_CASE("the other entry shaders compile") {
                             "tests/environment_test.comp"}) {
     std::string log = validate(lib.expand(entry, {}));
     INFO(entry);
+    CHECK_MESSAGE(log.empty(), log);
+  }
+  for (const char* stage : {"CAUSTICA_DENOISE_PREPARE", "CAUSTICA_DENOISE_PASS", "CAUSTICA_DENOISE_RESIDUAL"}) {
+    std::string log = validate(lib.expand("denoise.comp", {stage}));
+    INFO("denoise.comp: " << stage);
     CHECK_MESSAGE(log.empty(), log);
   }
 }
