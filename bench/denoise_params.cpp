@@ -54,7 +54,7 @@ double regionMean(const Image& img, const PixelRect& r) {
 int main(int argc, char** argv) {
   try {
     std::string refPath;
-    std::vector<double> caustic, iterations = {5}, residuals = {5}, sigmaL = {8}, sigmaZ = {1}, floors = {0.01};
+    std::vector<double> caustic, iterations = {5}, residuals = {5}, sigmaR = {0.3}, bounds = {2}, sigmaL = {6}, sigmaZ = {1}, floors = {0.01};
     std::vector<std::string> checkpoints;
     std::vector<std::string> images;  // --image FILE: also print these images' figures (e.g. render --denoise outputs)
     std::string dump;
@@ -72,6 +72,8 @@ int main(int argc, char** argv) {
       else if (a == "--sigma-depth") sigmaZ = numbers(next());
       else if (a == "--albedo-floor") floors = numbers(next());
       else if (a == "--residual-passes") residuals = numbers(next());
+      else if (a == "--sigma-residual") sigmaR = numbers(next());
+      else if (a == "--residual-bound") bounds = numbers(next());
       else if (a == "--dump") dump = next();
       else if (a == "--image") images.push_back(next());
       else if (a == "--deficit") deficit = true;
@@ -105,17 +107,21 @@ int main(int argc, char** argv) {
       const DenoiseInput in{st.width, st.height, &st.accum, &st.albedo, &st.normal};
       for (double it : iterations)
        for (double rp : residuals)
+        for (double sr : sigmaR)
+         for (double rb : bounds)
         for (double l : sigmaL)
           for (double z : sigmaZ)
             for (double f : floors) {
               DenoiseSettings s;
               s.iterations = static_cast<int>(it);
               s.residualPasses = static_cast<int>(rp);
+              s.sigmaResidual = static_cast<float>(sr);
+              s.residualBound = static_cast<float>(rb);
               s.sigmaLuminance = static_cast<float>(l);
               s.sigmaDepth = static_cast<float>(z);
               s.albedoFloor = static_cast<float>(f);
               char name[128];
-              std::snprintf(name, sizeof name, "it %d, res %d, sL %g, sZ %g, floor %g", s.iterations, s.residualPasses, l, z, f);
+              std::snprintf(name, sizeof name, "it %d, res %d, sR %g, bound %g, sL %g, sZ %g, floor %g", s.iterations, s.residualPasses, sr, rb, l, z, f);
               const Image out = meanImage(denoiseSums(in, s), st.width, st.height);
               row(name, out);
               if (deficit) {  // where the denoised image lost (or gained) energy against the raw one

@@ -1,10 +1,9 @@
 // denoise.comp — the edge-aware à-trous denoiser (docs/denoising.md), one stage per variant:
-// CAUSTICA_DENOISE_PREPARE divides each pixel's mean by its albedo and finds its variance, normal,
-// distance and distance gradient; CAUSTICA_DENOISE_PASS is one à-trous pass with taps `step` pixels
-// apart, the last one multiplying the albedo back in; CAUSTICA_DENOISE_RESIDUAL one pass spreading what
-// the filter took from each pixel over its surface, the last one adding it to the output. C++ twin:
-// app/image/denoise.cpp.
-// Radiance linear; distances in scene units.
+// CAUSTICA_DENOISE_PREPARE divides each pixel's mean by its albedo and finds its variance, guide
+// (normal, albedo, distance) and distance gradient; CAUSTICA_DENOISE_PASS is one à-trous pass with taps
+// `step` pixels apart, the last one multiplying the albedo back in; CAUSTICA_DENOISE_RESIDUAL one pass
+// spreading what the filter took from each pixel over its surface, the last one adding it to the output.
+// C++ twin: app/image/denoise.cpp. Radiance linear; distances in scene units.
 #include "shared/gpu_layout.h"
 #include "lib/sampling.glsl"
 #include "lib/denoise.glsl"
@@ -25,7 +24,7 @@ layout(rgba32f, binding = CAUSTICA_DENOISE_IMAGE_NORMAL) uniform restrict readon
 layout(location = 4) uniform float albedoFloor;
 
 // Unit mean normal (0: none) and mean distance of pixel q; w = -1 without samples.
-vec4 pixelGuide(ivec2 q) {
+vec4 pixelNormalDistance(ivec2 q) {
   vec4 acc = imageLoad(accumImage, q);
   if (!(acc.a > 0.0)) return vec4(0.0, 0.0, 0.0, -1.0);
   vec4 ns = imageLoad(normalImage, q);
@@ -41,7 +40,7 @@ float denoiseAxisGradient(ivec2 p, ivec2 d, float z, ivec2 size) {
   for (int sign = -1; sign <= 1; sign += 2) {
     ivec2 q = p + sign * d;
     if (!insideImage(q, size)) continue;
-    vec4 g = pixelGuide(q);
+    vec4 g = pixelNormalDistance(q);
     if (g.w >= 0.0) best = min(best, abs(g.w - z));
   }
   return best < 3.0e38 ? best : 0.0;
@@ -52,9 +51,9 @@ void main() {
   ivec2 size = imageSize(accumImage);
   if (!insideImage(p, size)) return;
   vec4 acc = imageLoad(accumImage, p);
-  vec4 gp = pixelGuide(p);
-  imageStore(guideImage, p, gp);
+  vec4 nz = pixelNormalDistance(p);
   if (!(acc.a > 0.0)) {
+    imageStore(guideImage, p, nz);
     imageStore(pongImage, p, vec4(0.0));
     imageStore(centreImage, p, vec4(1.0, 1.0, 1.0, 0.0));
     return;
@@ -64,23 +63,22 @@ void main() {
   vec4 as = imageLoad(albedoImage, p);
   vec3 alb = max(as.rgb / n, vec3(albedoFloor));
   vec3 illum = mean / alb;
-  float z = gp.w;
+  float z = nz.w;
   float gradient = denoiseAxisGradient(p, ivec2(1, 0), z, size) + denoiseAxisGradient(p, ivec2(0, 1), z, size);
   float var;
   if (n >= kDenoiseMinTemporalSamples) {
-    float l = luminance(mean);
-    var = max(as.a / n - l * l, 0.0) / (n - 1.0);
+    var = denoiseMeanVariance(n, as.a, luminance(mean));
   } else {  // luminance moments of the similar pixels around
     float s0 = 0.0, s1 = 0.0, s2 = 0.0;
     for (int j = -2; j <= 2; ++j)
       for (int k = -2; k <= 2; ++k) {
         ivec2 q = p + ivec2(k, j);
         if (!insideImage(q, size)) continue;
-        vec4 gq = pixelGuide(q);
+        vec4 gq = pixelNormalDistance(q);
         if (gq.w < 0.0) continue;
         vec4 aq = imageLoad(accumImage, q);
         float l = luminance(aq.rgb / aq.a);
-        float wq = denoiseTapWeight(gp.xyz, gq.xyz, z, gq.w, denoiseDepthScale(sigmaDepth, gradient, max(abs(j), abs(k)), z),
+        float wq = denoiseTapWeight(nz.xyz, gq.xyz, z, gq.w, denoiseDepthScale(sigmaDepth, gradient, max(abs(j), abs(k)), z),
                                     0.0, 1.0);
         s0 += wq;
         s1 += wq * l;
@@ -89,6 +87,7 @@ void main() {
     float m = s1 / s0;
     var = max(s2 / s0 - m * m, 0.0);
   }
+  imageStore(guideImage, p, denoiseGuide(nz.xyz, luminance(alb), z));
   imageStore(pongImage, p, vec4(illum, var));
   imageStore(centreImage, p, vec4(alb, gradient));
 }
@@ -109,8 +108,8 @@ layout(location = 2) uniform float sigmaLuminance;
 
 // One à-trous pass: 3x3 taps `step` pixels apart, weighted by the kernel and denoiseTapWeight, over the
 // demodulated illumination and its variance (ping: rgb, a). The last pass writes the remodulated output
-// (last 1), or what the filter took from each pixel, the raw mean minus the output, for the residual
-// passes (last 2; output image, rgb).
+// (last 1), or (last 2) what the filter took from each pixel, the raw mean minus the output, with the
+// filtered illumination's luminance (output image: rgb, a) for the residual passes.
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = imageSize(pingImage);
@@ -122,7 +121,8 @@ void main() {
     return;
   }
   vec4 cp = imageLoad(pingImage, p), ctr = imageLoad(centreImage, p);
-  float ls = sigmaLuminance * sqrt(cp.a) + kDenoiseTiny;
+  vec3 np = denoiseGuideNormal(gp);
+  float ap = denoiseGuideAlbedo(gp);
   float ds = denoiseDepthScale(sigmaDepth, ctr.a, step, gp.w);
   float sumW = kKernel[0] * kKernel[0];
   vec3 sumI = sumW * cp.rgb;
@@ -136,7 +136,8 @@ void main() {
       if (gq.w < 0.0) continue;
       vec4 cq = imageLoad(pingImage, q);
       float lumDiff = luminance(ctr.rgb * (cq.rgb - cp.rgb));
-      float wq = kKernel[abs(j)] * kKernel[abs(k)] * denoiseTapWeight(gp.xyz, gq.xyz, gp.w, gq.w, ds, lumDiff, ls);
+      float ls = denoiseLuminanceScale(sigmaLuminance, cp.a, cq.a, ap, denoiseGuideAlbedo(gq));
+      float wq = kKernel[abs(j)] * kKernel[abs(k)] * denoiseTapWeight(np, denoiseGuideNormal(gq), gp.w, gq.w, ds, lumDiff, ls);
       sumW += wq;
       sumI += wq * cq.rgb;
       sumV += wq * wq * cq.a;
@@ -146,17 +147,20 @@ void main() {
   if (last == 0) return;
   vec4 acc = imageLoad(accumImage, p);
   if (last == 1) imageStore(outputImage, p, vec4(ctr.rgb * illum * acc.a, acc.a));
-  else imageStore(outputImage, p, vec4(acc.rgb / acc.a - ctr.rgb * illum, 0.0));
+  else imageStore(outputImage, p, vec4(acc.rgb / acc.a - ctr.rgb * illum, luminance(illum)));
 }
 #endif
 
 #ifdef CAUSTICA_DENOISE_RESIDUAL
 layout(rgba32f, binding = CAUSTICA_DENOISE_IMAGE_FILTERED) uniform restrict readonly image2D filteredImage;
+layout(rgba32f, binding = CAUSTICA_DENOISE_IMAGE_MOMENTS) uniform restrict readonly image2D momentImage;
 layout(location = 5) uniform float sigmaResidual;
+layout(location = 6) uniform float residualBound;
 
 // One residual pass: the same taps, weighted by normal, distance and the relative difference of the
-// filtered illumination's luminance, spread the residual (ping, rgb) over its surface and its like; the
-// last one writes the output: the filtered image (filtered illumination x albedo) plus the spread residual.
+// filtered illumination's luminance (ping: residual rgb, that luminance a), spread the residual over its
+// surface and its like; the last one writes the output: the filtered illumination x albedo (filtered
+// image) plus the spread residual, at most residualBound standard deviations of the pixel's mean.
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = imageSize(pingImage);
@@ -168,11 +172,11 @@ void main() {
     return;
   }
   vec4 ctr = imageLoad(centreImage, p);
-  vec3 filtered = imageLoad(filteredImage, p).rgb;
-  float lp = luminance(filtered);
+  vec4 rp = imageLoad(pingImage, p);
+  vec3 np = denoiseGuideNormal(gp);
   float ds = denoiseDepthScale(sigmaDepth, ctr.a, step, gp.w);
   float sumW = kKernel[0] * kKernel[0];
-  vec3 sumR = sumW * imageLoad(pingImage, p).rgb;
+  vec3 sumR = sumW * rp.rgb;
   for (int j = -1; j <= 1; ++j)
     for (int k = -1; k <= 1; ++k) {
       if (j == 0 && k == 0) continue;
@@ -180,17 +184,20 @@ void main() {
       if (!insideImage(q, size)) continue;
       vec4 gq = imageLoad(guideImage, q);
       if (gq.w < 0.0) continue;
-      float lq = luminance(imageLoad(filteredImage, q).rgb);
+      vec4 rq = imageLoad(pingImage, q);
       float wq = kKernel[abs(j)] * kKernel[abs(k)] *
-                 denoiseTapWeight(gp.xyz, gq.xyz, gp.w, gq.w, ds, lp - lq, sigmaResidual * (lp + lq) + kDenoiseTiny);
+                 denoiseTapWeight(np, denoiseGuideNormal(gq), gp.w, gq.w, ds, rp.a - rq.a, sigmaResidual * (rp.a + rq.a) + kDenoiseTiny);
       sumW += wq;
-      sumR += wq * imageLoad(pingImage, q).rgb;
+      sumR += wq * rq.rgb;
     }
   vec3 spread = sumR / sumW;
-  imageStore(pongImage, p, vec4(spread, 0.0));
+  imageStore(pongImage, p, vec4(spread, rp.a));
   if (last != 0) {
-    float n = imageLoad(accumImage, p).a;
-    imageStore(outputImage, p, vec4((ctr.rgb * filtered + spread) * n, n));
+    vec4 acc = imageLoad(accumImage, p);
+    vec3 correction = spread;
+    if (acc.a >= kDenoiseMinTemporalSamples)
+      correction = denoiseBoundedCorrection(correction, residualBound, acc.a, imageLoad(momentImage, p).a, luminance(acc.rgb / acc.a));
+    imageStore(outputImage, p, vec4((ctr.rgb * imageLoad(filteredImage, p).rgb + correction) * acc.a, acc.a));
   }
 }
 #endif

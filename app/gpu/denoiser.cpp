@@ -65,6 +65,8 @@ const GlTexture& Denoiser::run(const GlTexture& accum, const GlTexture& albedo, 
     residual_.use();
     glUniform1f(3, settings.sigmaDepth);
     glUniform1f(5, settings.sigmaResidual);
+    glUniform1f(6, settings.residualBound);
+    albedo.bindImage(CAUSTICA_DENOISE_IMAGE_MOMENTS, GL_READ_ONLY);
     in->bindImage(CAUSTICA_DENOISE_IMAGE_FILTERED, GL_READ_ONLY);
     output_.bindImage(CAUSTICA_DENOISE_IMAGE_OUTPUT, GL_WRITE_ONLY);
     GlTexture* rin = &residualA_;

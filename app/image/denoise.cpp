@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 #include <glm/glm.hpp>
 
@@ -21,6 +22,7 @@ using glm::vec4;
 constexpr float kTiny = 1e-30f;             // keeps a zero scale from dividing 0 by 0
 constexpr float kNormalMinLength = 1e-3f;   // a mean normal shorter than this: no surface
 constexpr float kDepthRelative = 1e-3f;     // distance differences below this fraction are ignored
+constexpr float kDenoiseAlbedoMatch = 0.01f;  // albedo luminance difference for which a neighbour's variance counts 1/e
 // The kernel of a pass by |offset|: 1/4, 1/2, 1/4 (3x3 taps; 5x5 B3-spline taps measured no better and
 // cost 2.8x as much: docs/denoising.md).
 constexpr float kKernel[2] = {1.0f / 2.0f, 1.0f / 4.0f};
@@ -37,8 +39,8 @@ class Sums {
   vec4 accum(int x, int y) const { return at(*in_.accum, x, y); }
   vec4 albedo(int x, int y) const { return at(*in_.albedo, x, y); }
   vec4 normal(int x, int y) const { return at(*in_.normal, x, y); }
-  // denoisePixelGuide: unit mean normal (0: none) and mean distance; w = -1 without samples.
-  vec4 guide(int x, int y) const {
+  // pixelNormalDistance: unit mean normal (0: none) and mean distance; w = -1 without samples.
+  vec4 normalDistance(int x, int y) const {
     const vec4 acc = accum(x, y);
     if (!(acc.w > 0.0f)) return vec4(0.0f, 0.0f, 0.0f, -1.0f);
     const vec4 ns = normal(x, y);
@@ -58,7 +60,7 @@ float denoiseAxisGradient(const Sums& s, int x, int y, int dx, int dy, float z) 
   for (int sign = -1; sign <= 1; sign += 2) {
     const int qx = x + sign * dx, qy = y + sign * dy;
     if (!s.inside(qx, qy)) continue;
-    const vec4 g = s.guide(qx, qy);
+    const vec4 g = s.normalDistance(qx, qy);
     if (g.w >= 0.0f) best = std::min(best, std::abs(g.w - z));
   }
   return best < 3.0e38f ? best : 0.0f;
@@ -79,6 +81,34 @@ float denoiseNormalWeight(const float np[3], const float nq[3]) {
   return c;
 }
 
+glm::vec4 denoiseGuide(const glm::vec3& n, float albedoLum, float distance) {
+  if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return glm::vec4(0.0f, 0.0f, 0.0f, distance);
+  return glm::vec4(n.x, n.y, (n.z < 0.0f ? -1.0f : 1.0f) * (1.0f + albedoLum), distance);
+}
+
+glm::vec3 denoiseGuideNormal(const glm::vec4& g) {
+  if (g.z == 0.0f) return glm::vec3(0.0f);
+  return glm::vec3(g.x, g.y, (g.z < 0.0f ? -1.0f : 1.0f) * std::sqrt(std::max(1.0f - g.x * g.x - g.y * g.y, 0.0f)));
+}
+
+float denoiseGuideAlbedo(const glm::vec4& g) { return g.z == 0.0f ? 0.0f : std::abs(g.z) - 1.0f; }
+
+float denoiseMeanVariance(float n, float m2, float l) {
+  const float meanSquare = m2 / n;
+  return std::max(meanSquare - l * l - (n + 2.0f) * std::numeric_limits<float>::epsilon() * meanSquare, 0.0f) / (n - 1.0f);
+}
+
+float denoiseLuminanceScale(float sigma, float varP, float varQ, float albedoP, float albedoQ) {
+  const float match = std::exp(-std::abs(albedoP - albedoQ) / kDenoiseAlbedoMatch);
+  return sigma * std::sqrt(varP + match * varQ) + kTiny;
+}
+
+glm::vec3 denoiseBoundedCorrection(const glm::vec3& correction, float bound, float n, float m2, float l) {
+  const float limit = bound * std::sqrt(denoiseMeanVariance(n, m2, l));
+  const float size = std::abs(luminance(correction));
+  return size > limit ? correction * (limit / size) : correction;
+}
+
 float denoiseTapWeight(const float np[3], const float nq[3], float zp, float zq, float depthScaleValue, float lumDiff,
                        float luminanceScale) {
   return denoiseNormalWeight(np, nq) * std::exp(-(std::abs(zp - zq) / depthScaleValue + std::abs(lumDiff) / luminanceScale));
@@ -93,15 +123,16 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
   const Sums s(in);
   const int w = in.width, h = in.height;
   auto idx = [w](int x, int y) { return static_cast<std::size_t>(y) * w + x; };
-  // prepare: demodulated illumination and the variance of the mean (ping), normal and distance (guide),
-  // albedo and distance gradient (centre).
+  // prepare: demodulated illumination and the variance of the mean (ping), guide (normal, albedo,
+  // distance), albedo and distance gradient (centre).
   std::vector<vec4> ping(pixels), guide(pixels), centre(pixels);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const vec4 acc = s.accum(x, y);
       const std::size_t i = idx(x, y);
-      guide[i] = s.guide(x, y);
+      const vec4 nz = s.normalDistance(x, y);
       if (!(acc.w > 0.0f)) {
+        guide[i] = nz;
         ping[i] = vec4(0.0f);
         centre[i] = vec4(1.0f, 1.0f, 1.0f, 0.0f);
         continue;
@@ -111,26 +142,25 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
       const vec4 as = s.albedo(x, y);
       const vec3 alb = glm::max(vec3(as) / n, vec3(settings.albedoFloor));
       const vec3 illum = mean / alb;
-      const float z = guide[i].w;
+      const float z = nz.w;
       const float gradient = denoiseAxisGradient(s, x, y, 1, 0, z) + denoiseAxisGradient(s, x, y, 0, 1, z);
       float var;
       if (n >= kDenoiseMinTemporalSamples) {
-        const float l = luminance(mean);
-        var = std::max(as.w / n - l * l, 0.0f) / (n - 1.0f);
-      } else {  // denoiseSpatialVariance: luminance moments of the similar pixels around
+        var = denoiseMeanVariance(n, as.w, luminance(mean));
+      } else {  // luminance moments of the similar pixels around
         float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        const float np[3] = {guide[i].x, guide[i].y, guide[i].z};
+        const float np[3] = {nz.x, nz.y, nz.z};
         for (int j = -2; j <= 2; ++j)
           for (int k = -2; k <= 2; ++k) {
             const int qx = x + k, qy = y + j;
             if (!s.inside(qx, qy)) continue;
-            const vec4 gq = s.guide(qx, qy);
+            const vec4 gq = s.normalDistance(qx, qy);
             if (gq.w < 0.0f) continue;
             const float nq[3] = {gq.x, gq.y, gq.z};
             const vec4 aq = s.accum(qx, qy);
             const float l = luminance(vec3(aq) / aq.w);
-            const float wq = denoiseTapWeight(np, nq, z, gq.w, denoiseDepthScale(settings.sigmaDepth, gradient, std::max(std::abs(j), std::abs(k)), z),
-                                              0.0f, 1.0f);
+            const float wq = denoiseTapWeight(np, nq, z, gq.w,
+                                              denoiseDepthScale(settings.sigmaDepth, gradient, std::max(std::abs(j), std::abs(k)), z), 0.0f, 1.0f);
             s0 += wq;
             s1 += wq * l;
             s2 += wq * l * l;
@@ -138,12 +168,13 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
         const float m = s1 / s0;
         var = std::max(s2 / s0 - m * m, 0.0f);
       }
+      guide[i] = denoiseGuide(vec3(nz), luminance(alb), z);
       ping[i] = vec4(illum, var);
       centre[i] = vec4(alb, gradient);
     }
   // The à-trous passes: 3x3 taps `step` pixels apart, weighted by the kernel and denoiseTapWeight.
   std::vector<vec4> pong(pixels);
-  std::vector<vec3> residual(settings.residualPasses > 0 ? pixels : 0);
+  std::vector<vec4> residual(settings.residualPasses > 0 ? pixels : 0);  // rgb, and the filtered luminance
   std::vector<float> out(pixels * 4, 0.0f);
   auto writeOut = [&](std::size_t i, vec3 value, float n) {
     const vec3 c = value * n;
@@ -161,12 +192,14 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
         const vec4 gp = guide[i];
         if (gp.w < 0.0f) {
           pong[i] = vec4(0.0f);
-          if (last && !residual.empty()) residual[i] = vec3(0.0f);
+          if (last && !residual.empty()) residual[i] = vec4(0.0f);
           continue;
         }
         const vec4 cp = ping[i], ctr = centre[i];
-        const float np[3] = {gp.x, gp.y, gp.z};
-        const float ls = settings.sigmaLuminance * std::sqrt(cp.w) + kTiny;
+        const vec3 npv = denoiseGuideNormal(gp);
+        const float np[3] = {npv.x, npv.y, npv.z};
+        const float ap = denoiseGuideAlbedo(gp);
+        const float ds = denoiseDepthScale(settings.sigmaDepth, ctr.w, step, gp.w);
         float sumW = kKernel[0] * kKernel[0];
         vec3 sumI = sumW * vec3(cp);
         float sumV = sumW * sumW * cp.w;
@@ -178,9 +211,10 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
             const vec4 gq = guide[idx(qx, qy)];
             if (gq.w < 0.0f) continue;
             const vec4 cq = ping[idx(qx, qy)];
-            const float nq[3] = {gq.x, gq.y, gq.z};
-            const float ds = denoiseDepthScale(settings.sigmaDepth, ctr.w, step, gp.w);
+            const vec3 nqv = denoiseGuideNormal(gq);
+            const float nq[3] = {nqv.x, nqv.y, nqv.z};
             const float lumDiff = luminance(vec3(ctr) * (vec3(cq) - vec3(cp)));
+            const float ls = denoiseLuminanceScale(settings.sigmaLuminance, cp.w, cq.w, ap, denoiseGuideAlbedo(gq));
             const float wq = kKernel[std::abs(j)] * kKernel[std::abs(k)] * denoiseTapWeight(np, nq, gp.w, gq.w, ds, lumDiff, ls);
             sumW += wq;
             sumI += wq * vec3(cq);
@@ -191,7 +225,7 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
         if (!last) continue;
         const vec4 acc = s.accum(x, y);
         if (residual.empty()) writeOut(i, vec3(ctr) * illum, acc.w);
-        else residual[i] = vec3(acc) / acc.w - vec3(ctr) * illum;  // what the filter took away (or added)
+        else residual[i] = vec4(vec3(acc) / acc.w - vec3(ctr) * illum, luminance(illum));  // what the filter took away
       }
     std::swap(ping, pong);
   }
@@ -199,7 +233,7 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
   // filtered illumination's luminance, spread what the filter took from each pixel over its surface and
   // its like, so the image keeps its energy (a firefly's, a caustic's) where it was; the output is the
   // filtered image plus that.
-  std::vector<vec3> spread(residual.size());
+  std::vector<vec4> spread(residual.size());
   for (int pass = 0; pass < settings.residualPasses; ++pass) {
     const int step = 1 << pass;
     const bool last = pass + 1 == settings.residualPasses;
@@ -208,13 +242,15 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
         const std::size_t i = idx(x, y);
         const vec4 gp = guide[i];
         if (gp.w < 0.0f) {
-          spread[i] = vec3(0.0f);
+          spread[i] = vec4(0.0f);
           continue;
         }
-        const float np[3] = {gp.x, gp.y, gp.z};
-        const float lp = luminance(vec3(ping[i]));  // the filtered illumination
+        const vec4 rp = residual[i];
+        const vec3 npv = denoiseGuideNormal(gp);
+        const float np[3] = {npv.x, npv.y, npv.z};
+        const float ds = denoiseDepthScale(settings.sigmaDepth, centre[i].w, step, gp.w);
         float sumW = kKernel[0] * kKernel[0];
-        vec3 sumR = sumW * residual[i];
+        vec3 sumR = sumW * vec3(rp);
         for (int j = -1; j <= 1; ++j)
           for (int k = -1; k <= 1; ++k) {
             if (j == 0 && k == 0) continue;
@@ -222,16 +258,22 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
             if (!s.inside(qx, qy)) continue;
             const vec4 gq = guide[idx(qx, qy)];
             if (gq.w < 0.0f) continue;
-            const float nq[3] = {gq.x, gq.y, gq.z};
-            const float ds = denoiseDepthScale(settings.sigmaDepth, centre[i].w, step, gp.w);
-            const float lq = luminance(vec3(ping[idx(qx, qy)]));
+            const vec4 rq = residual[idx(qx, qy)];
+            const vec3 nqv = denoiseGuideNormal(gq);
+            const float nq[3] = {nqv.x, nqv.y, nqv.z};
             const float wq = kKernel[std::abs(j)] * kKernel[std::abs(k)] *
-                             denoiseTapWeight(np, nq, gp.w, gq.w, ds, lp - lq, settings.sigmaResidual * (lp + lq) + kTiny);
+                             denoiseTapWeight(np, nq, gp.w, gq.w, ds, rp.w - rq.w, settings.sigmaResidual * (rp.w + rq.w) + kTiny);
             sumW += wq;
-            sumR += wq * residual[idx(qx, qy)];
+            sumR += wq * vec3(rq);
           }
-        spread[i] = sumR / sumW;
-        if (last) writeOut(i, vec3(centre[i]) * vec3(ping[i]) + spread[i], s.accum(x, y).w);
+        spread[i] = vec4(sumR / sumW, rp.w);
+        if (last) {
+          const vec4 acc = s.accum(x, y);
+          vec3 correction = vec3(spread[i]);
+          if (acc.w >= kDenoiseMinTemporalSamples)
+            correction = denoiseBoundedCorrection(correction, settings.residualBound, acc.w, s.albedo(x, y).w, luminance(vec3(acc) / acc.w));
+          writeOut(i, vec3(centre[i]) * vec3(ping[i]) + correction, acc.w);
+        }
       }
     std::swap(residual, spread);
   }
@@ -254,8 +296,7 @@ FeatureImages featureImages(const DenoiseInput& in) {
       f.normal.rgb[i * 3 + c] = (*in.normal)[i * 4 + c] / n;
       mean[c] = (*in.accum)[i * 4 + c] / n;
     }
-    const float l = luminance(mean);
-    const float var = n >= 2.0f ? std::max((*in.albedo)[i * 4 + 3] / n - l * l, 0.0f) / (n - 1.0f) : 0.0f;
+    const float var = n >= 2.0f ? denoiseMeanVariance(n, (*in.albedo)[i * 4 + 3], luminance(mean)) : 0.0f;
     for (int c = 0; c < 3; ++c) {
       f.depth.rgb[i * 3 + c] = (*in.normal)[i * 4 + 3] / n;
       f.variance.rgb[i * 3 + c] = var;

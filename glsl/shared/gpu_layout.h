@@ -62,7 +62,8 @@ using uint = std::uint32_t;
 #define CAUSTICA_DENOISE_IMAGE_ACCUM 0   // rgba32f accumulation sums (read)
 #define CAUSTICA_DENOISE_IMAGE_ALBEDO 1  // rgba32f feature sums: albedo, luminance^2 (read by the prepare stage)
 #define CAUSTICA_DENOISE_IMAGE_FILTERED 1  // rgba32f the filter passes' last output (read by the residual passes)
-#define CAUSTICA_DENOISE_IMAGE_NORMAL 2  // rgba32f feature sums: normal, distance (read)
+#define CAUSTICA_DENOISE_IMAGE_NORMAL 2  // rgba32f feature sums: normal, distance (read by the prepare stage)
+#define CAUSTICA_DENOISE_IMAGE_MOMENTS 2 // rgba32f feature sums: albedo, luminance^2 (read by the last residual pass)
 #define CAUSTICA_DENOISE_IMAGE_PING 3    // rgba32f demodulated illumination (rgb) and variance of the mean (a), or
                                          // the residual (rgb), read by a pass
 #define CAUSTICA_DENOISE_IMAGE_PONG 4    // the same, written by a pass (and by prepare)
