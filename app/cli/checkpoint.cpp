@@ -101,8 +101,8 @@ Checkpoint readCheckpoint(const std::string& path) {
   };
   const unsigned long long version = num(kCheckpointMagic);
   if (version < kCheckpointOldestVersion || version > kCheckpointVersion)
-    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads version " +
-              std::to_string(kCheckpointVersion) +
+    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads versions " +
+              std::to_string(kCheckpointOldestVersion) + " to " + std::to_string(kCheckpointVersion) +
               (version < kCheckpointOldestVersion ? ", whose settings name every option that changes the image; "
                                                     "render again to write one"
                                                   : "") +

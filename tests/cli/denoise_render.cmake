@@ -1,0 +1,58 @@
+# denoise_render.cmake — `render --denoise` and `--aov` as a user runs them (docs/denoising.md): the
+# denoised output, the feature files beside a PNG, the raw image staying the default, checkpoints that
+# keep the feature sums (resume continues the denoised render bit for bit), and clear refusals
+# (run with cmake -P; CLI, COMPARE (viewer_image_compare) and DIR given).
+file(REMOVE_RECURSE ${DIR})
+file(MAKE_DIRECTORY ${DIR})
+set(COMMON cornell-glass --size 24 --backend osmesa -q)
+include(${CMAKE_CURRENT_LIST_DIR}/cli_run.cmake)
+
+# The raw image stays the default: the same bits with --aov (feature buffers on) as without.
+run(0 ${COMMON} --spp 8 -o ${DIR}/raw.pfm)
+run(0 ${COMMON} --spp 8 --aov albedo -o ${DIR}/raw-aov.pfm)
+file(SHA256 ${DIR}/raw.pfm a)
+file(SHA256 ${DIR}/raw-aov.pfm b)
+if(NOT a STREQUAL b)
+  message(FATAL_ERROR "--aov changed the raw image")
+endif()
+
+# --denoise writes another image; --aov all beside a PNG writes the raw image as PNG and the features as PFM.
+run(0 ${COMMON} --spp 8 --denoise --aov all -o ${DIR}/den.png)
+foreach(f den.png den.raw.png den.albedo.pfm den.normal.pfm den.depth.pfm den.variance.pfm)
+  if(NOT EXISTS ${DIR}/${f})
+    message(FATAL_ERROR "render --denoise --aov all -o den.png wrote no ${f}")
+  endif()
+endforeach()
+run(0 ${COMMON} --spp 8 --denoise -o ${DIR}/den.pfm)
+execute_process(COMMAND ${COMPARE} ${DIR}/den.pfm ${DIR}/raw.pfm RESULT_VARIABLE crc OUTPUT_VARIABLE cout)
+if(NOT crc EQUAL 1)
+  message(FATAL_ERROR "the denoised image should differ from the raw one: ${cout}")
+endif()
+
+# Checkpoints keep the feature sums: 4 + 4 spp resumed with --denoise equals 8 spp straight.
+run(0 ${COMMON} --spp 4 --denoise --checkpoint 1000 -o ${DIR}/half.pfm)
+run(0 ${COMMON} --spp 8 --denoise --resume ${DIR}/half.pfm.ckpt -o ${DIR}/resumed.pfm)
+file(SHA256 ${DIR}/den.pfm c)
+file(SHA256 ${DIR}/resumed.pfm d)
+if(NOT c STREQUAL d)
+  message(FATAL_ERROR "the resumed denoised render differs from the straight one")
+endif()
+# A checkpoint with them resumes without --denoise too (the raw image, the same bits).
+run(0 ${COMMON} --spp 8 --resume ${DIR}/half.pfm.ckpt -o ${DIR}/resumed-raw.pfm)
+file(SHA256 ${DIR}/resumed-raw.pfm e)
+if(NOT e STREQUAL a)
+  message(FATAL_ERROR "resuming a checkpoint with feature sums without --denoise changed the raw image")
+endif()
+
+function(refused pattern)
+  run(1 ${ARGN})
+  if(NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "render ${ARGN}: the refusal does not say '${pattern}': ${err}")
+  endif()
+endfunction()
+run(0 ${COMMON} --spp 4 --checkpoint 1000 -o ${DIR}/plain.pfm)
+refused("plain.pfm.ckpt: has no feature sums \\(it was rendered without --denoise or --aov\\)"
+        ${COMMON} --spp 8 --denoise --resume ${DIR}/plain.pfm.ckpt -o ${DIR}/x.pfm)
+refused("--denoise needs the path tracer \\(--mode path\\), not --mode whitted" ${COMMON} --mode whitted --denoise -o ${DIR}/x.png)
+refused("option --aov: unknown feature buffer 'albedos' \\(expected albedo, normal, depth, variance, raw or all\\)"
+        ${COMMON} --aov normal,albedos -o ${DIR}/x.png)
