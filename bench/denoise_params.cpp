@@ -41,14 +41,6 @@ Image meanImage(const std::vector<float>& sums, int w, int h) {
   return img;
 }
 
-double regionMean(const Image& img, const PixelRect& r) {
-  double sum = 0.0;
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x)
-      for (int c = 0; c < 3; ++c) sum += img.at(x, y, c);
-  return sum / (3.0 * r.width() * r.height());
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -85,13 +77,13 @@ int main(int argc, char** argv) {
     const PixelRect whole = fullImage(ref.width, ref.height);
     const bool hasCaustic = caustic.size() == 4;
     const PixelRect region = hasCaustic ? cropToPixels(CropRect{caustic[0], caustic[1], caustic[2], caustic[3]}, ref.width, ref.height) : whole;
-    const double refMean = regionMean(ref, whole), refCaustic = regionMean(ref, region);
+    const double refMean = imageMean(ref, whole), refCaustic = imageMean(ref, region);
     std::printf("| checkpoint | spp | filter | relMSE | caustic relMSE | mean / ref | caustic mean / ref |\n|---|--:|---|--:|--:|--:|--:|\n");
     for (const std::string& path : images) {
       const Image img = readImage(path);
       std::printf("| %s | | image | %.4g | %s | %.4f | %s |\n", path.c_str(), relMse(img, ref),
-                  hasCaustic ? formatDouble("%.4g", relMse(img, ref, region)).c_str() : "-", regionMean(img, whole) / refMean,
-                  hasCaustic ? formatDouble("%.4f", regionMean(img, region) / refCaustic).c_str() : "-");
+                  hasCaustic ? formatDouble("%.4g", relMse(img, ref, region)).c_str() : "-", imageMean(img, whole) / refMean,
+                  hasCaustic ? formatDouble("%.4f", imageMean(img, region) / refCaustic).c_str() : "-");
     }
     for (const std::string& path : checkpoints) {
       const cli::Checkpoint ck = cli::readCheckpoint(path);
@@ -99,8 +91,8 @@ int main(int argc, char** argv) {
       if (!st.hasFeatures()) throw Error(path + ": no feature sums (render with --denoise)");
       auto row = [&](const std::string& filter, const Image& img) {
         std::printf("| %s | %d | %s | %.4g | %s | %.4f | %s |\n", path.c_str(), st.spp, filter.c_str(), relMse(img, ref),
-                    hasCaustic ? formatDouble("%.4g", relMse(img, ref, region)).c_str() : "-", regionMean(img, whole) / refMean,
-                    hasCaustic ? formatDouble("%.4f", regionMean(img, region) / refCaustic).c_str() : "-");
+                    hasCaustic ? formatDouble("%.4g", relMse(img, ref, region)).c_str() : "-", imageMean(img, whole) / refMean,
+                    hasCaustic ? formatDouble("%.4f", imageMean(img, region) / refCaustic).c_str() : "-");
         std::fflush(stdout);
       };
       row("raw", meanImage(st.accum, st.width, st.height));

@@ -38,14 +38,6 @@ Image meanOfSums(const std::vector<float>& sums, int w, int h) {
   return img;
 }
 
-double regionMean(const Image& img, const PixelRect& r) {
-  double s = 0.0;
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x)
-      for (int c = 0; c < 3; ++c) s += img.at(x, y, c);
-  return s / (3.0 * r.width() * r.height());
-}
-
 }  // namespace
 
 TEST_CASE("denoiser feature buffers: the raw image is the same bit for bit with and without them") {
@@ -269,9 +261,9 @@ TEST_CASE("denoiser: on cornell-glass at 16 spp the caustic region keeps its mea
   DenoiseSettings noResidual;
   noResidual.residualPasses = 0;
   const Image denoised = r16.denoisedImage(), raw = r16.image();
-  const double refMean = regionMean(ref.image, caustic);
-  const double kept = regionMean(denoised, caustic) / refMean, rawKept = regionMean(raw, caustic) / refMean;
-  const double lost = regionMean(meanOfSums(denoiseSums(in, noResidual), 128, 128), caustic) / refMean;
+  const double refMean = imageMean(ref.image, caustic);
+  const double kept = imageMean(denoised, caustic) / refMean, rawKept = imageMean(raw, caustic) / refMean;
+  const double lost = imageMean(meanOfSums(denoiseSums(in, noResidual), 128, 128), caustic) / refMean;
   INFO("caustic region mean over the reference's: denoised ", kept, ", raw ", rawKept, ", without residual passes ", lost);
   CHECK(kept == doctest::Approx(1.0).epsilon(0.03));
   CHECK(std::abs(lost - 1.0) > 0.03);
