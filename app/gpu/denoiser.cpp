@@ -16,10 +16,16 @@ GlProgram compileStage(const ShaderLibrary& library, const char* define) {
 
 }  // namespace
 
+const std::array<const char*, 3>& denoiseStageDefines() {
+  static const std::array<const char*, 3> stages = {"CAUSTICA_DENOISE_PREPARE", "CAUSTICA_DENOISE_PASS",
+                                                    "CAUSTICA_DENOISE_RESIDUAL"};
+  return stages;
+}
+
 Denoiser::Denoiser(const ShaderLibrary& library)
-    : prepare_(compileStage(library, "CAUSTICA_DENOISE_PREPARE")),
-      pass_(compileStage(library, "CAUSTICA_DENOISE_PASS")),
-      residual_(compileStage(library, "CAUSTICA_DENOISE_RESIDUAL")) {}
+    : prepare_(compileStage(library, denoiseStageDefines()[0])),
+      pass_(compileStage(library, denoiseStageDefines()[1])),
+      residual_(compileStage(library, denoiseStageDefines()[2])) {}
 
 const GlTexture& Denoiser::run(const GlTexture& accum, const GlTexture& albedo, const GlTexture& normal,
                                const DenoiseSettings& settings) {

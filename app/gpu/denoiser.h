@@ -1,12 +1,19 @@
 // denoiser.h — runs the à-trous denoiser (glsl/denoise.comp; docs/denoising.md) on the GPU over the
 // renderer's accumulation and feature images. The filter's arithmetic and its C++ twin: image/denoise.h.
 #pragma once
+#include <array>
+
 #include "gpu/gl_objects.h"
 #include "gpu/shader_library.h"
 #include "image/denoise.h"
 #include "shared/gpu_layout.h"
 
 namespace caustica {
+
+// The defines that select glsl/denoise.comp's stages, each compiled as a program of its own: prepare
+// (demodulate, variance, guide), one à-trous pass, one residual pass. Stage selectors, not features:
+// the shader-feature table does not list them.
+const std::array<const char*, 3>& denoiseStageDefines();
 
 class Denoiser {
  public:
