@@ -1,6 +1,6 @@
 // checkpoint.cpp — checkpoint file format: a text header after the magic line, then the three images'
 // raw floats (sums, Kahan compensation, odd-sample half), with "coverage 1" the coverage image's and with
-// "features 1" (version 5) the two feature-sum images' (native little-endian), protected by an FNV-1a 64
+// "features 1" (version 6) the two feature-sum images' (native little-endian), protected by an FNV-1a 64
 // checksum.
 #include "cli/checkpoint.h"
 
@@ -58,8 +58,11 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     << "sample-base " << st.sampleBase << '\n'
     << "coverage " << (st.coverage.empty() ? 0 : 1) << '\n';
   if (st.hasFeatures()) h << "features 1\n";
-  h << "seed " << ck.seed << '\n'
-    << "scene " << hex64(ck.sceneHash) << '\n'
+  h << "seed " << ck.seed << '\n';
+  if (ck.shard)
+    h << "shard " << ck.shard->index << '/' << ck.shard->count << ' ' << ck.shard->first << ' ' << ck.shard->end << ' '
+      << ck.shard->total << '\n';
+  h << "scene " << hex64(ck.sceneHash) << '\n'
     << "data " << hex64(dataHash(st)) << '\n'
     << "settings " << ck.identity.size() << '\n'
     << ck.identity << "end\n";
@@ -108,7 +111,7 @@ Checkpoint readCheckpoint(const std::string& path) {
                                                   : "") +
               ")");
   const bool coverage = num("coverage") != 0;
-  const bool features = head.count("features") != 0 && num("features") != 0;  // version 5
+  const bool features = head.count("features") != 0 && num("features") != 0;  // version 6
   Checkpoint ck;
   AccumulationState& st = ck.state;
   unsigned long long w = num("width"), hgt = num("height"), settingsBytes = num("settings");
@@ -121,6 +124,22 @@ Checkpoint readCheckpoint(const std::string& path) {
   st.sampleBase = static_cast<std::uint32_t>(num("sample-base"));
   ck.seed = static_cast<std::uint32_t>(num("seed"));
   ck.sceneHash = num("scene");
+  if (auto it = head.find("shard"); it != head.end()) {
+    SampleShare sh;
+    char slash = 0;
+    std::istringstream line(it->second);
+    long long k = 0, n = 0, first = 0, last = 0, total = 0;
+    std::string rest;
+    if (!(line >> k >> slash >> n >> first >> last >> total) || slash != '/' || (line >> rest) || k < 1 || k > n ||
+        n > (1 << 30) || first < 0 || first > last || last > total || total > (1ll << 31))
+      throw bad("bad shard line '" + it->second + "'");
+    sh.index = int(k);
+    sh.count = int(n);
+    sh.first = std::uint32_t(first);
+    sh.end = std::uint32_t(last);
+    sh.total = std::uint32_t(total);
+    ck.shard = sh;
+  }
   const std::uint64_t expected = num("data");
   if (settingsLineEnd + 1 + settingsBytes != end + 1) throw bad("settings text of the wrong length");
   ck.identity = bytes.substr(settingsLineEnd + 1, settingsBytes);

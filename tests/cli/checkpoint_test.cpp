@@ -71,7 +71,7 @@ TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
   CHECK(b.state.comp == a.state.comp);
   CHECK(b.state.half == a.state.half);
   CHECK(b.state.coverage.empty());  // an opaque render has no coverage image
-  CHECK(slurp(path).rfind("CAUSTICA-CKPT 4\n", 0) == 0);
+  CHECK(slurp(path).rfind("CAUSTICA-CKPT 5\n", 0) == 0);
   CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.identity).empty());
 }
 
@@ -96,11 +96,11 @@ TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; o
   // the file and what to do.
   writeCheckpoint(path, sample(3, 2, 1.5f));
   std::string v3 = slurp(path);
-  v3.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 3");
+  v3.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 3");
   spit(path, v3);
   CHECK_THROWS_WITH_AS(readCheckpoint(path),
                        doctest::Contains("coverage.ckpt: not a usable caustica checkpoint: version 3 (this caustica "
-                                         "reads versions 4 to 5, whose settings name every option that changes the image; "
+                                         "reads versions 4 to 6, whose settings name every option that changes the image; "
                                          "render again to write one)"),
                        Error);
 }
@@ -119,13 +119,13 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
   // A version-1 file (no half image: no error estimate to resume adaptive sampling from) is refused.
   std::string v1 = good;
-  v1.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 1");
+  v1.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 1");
   spit(path, v1);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 4 to 5"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 4 to 6"), Error);
   std::string v6 = good;
-  v6.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 6");
+  v6.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 7");
   spit(path, v6);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 6 (this caustica reads versions 4 to 5)"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 7 (this caustica reads versions 4 to 6)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);
@@ -175,19 +175,21 @@ TEST_CASE("checkpoint: a write interrupted before its rename leaves the previous
   fs::remove_all(fs::path(path).parent_path());
 }
 
-TEST_CASE("checkpoint: the denoiser's feature sums (version 5) round-trip, with and without coverage; without them it stays version 4") {
+TEST_CASE("checkpoint: the denoiser's feature sums (version 6) round-trip, with and without coverage and a shard line; without them it stays version 5") {
   for (bool coverage : {false, true}) {
     INFO("coverage ", coverage);
     const std::string path = tempPath("features.ckpt");
     Checkpoint a = sample(3, 2, 2.5f);
     if (coverage) a.state.coverage.assign(6, 3.0f);
+    if (coverage) a.shard = SampleShare{2, 3, 4, 8, 12};  // a shard's partial with feature sums
     for (int i = 0; i < 3 * 2 * 4; ++i) {
       a.state.albedo.push_back(0.1f * float(i));
       a.state.normal.push_back(-0.3f * float(i));
     }
     writeCheckpoint(path, a);
-    CHECK(slurp(path).rfind(std::string(kCheckpointMagic) + " 5\n", 0) == 0);
+    CHECK(slurp(path).rfind(std::string(kCheckpointMagic) + " 6\n", 0) == 0);
     const Checkpoint b = readCheckpoint(path);
+    CHECK(b.shard == a.shard);
     CHECK(b.state.albedo == a.state.albedo);
     CHECK(b.state.normal == a.state.normal);
     CHECK(b.state.coverage == a.state.coverage);
@@ -203,7 +205,7 @@ TEST_CASE("checkpoint: the denoiser's feature sums (version 5) round-trip, with 
   }
   const std::string path = tempPath("plain.ckpt");
   writeCheckpoint(path, sample(3, 2, 1.0f));
-  CHECK(slurp(path).rfind(std::string(kCheckpointMagic) + " 4\n", 0) == 0);  // readable by older versions
+  CHECK(slurp(path).rfind(std::string(kCheckpointMagic) + " 5\n", 0) == 0);  // readable by older versions
   CHECK_FALSE(readCheckpoint(path).state.hasFeatures());
   fs::remove(path);
 }

@@ -1,6 +1,7 @@
 # denoise_render.cmake — `render --denoise` and `--aov` as a user runs them (docs/denoising.md): the
 # denoised output, the feature files beside a PNG, the raw image staying the default, checkpoints that
-# keep the feature sums (resume continues the denoised render bit for bit), and clear refusals
+# keep the feature sums (resume continues the denoised render bit for bit), shards that keep them and
+# merge --denoise, and clear refusals
 # (run with cmake -P; CLI, COMPARE (viewer_image_compare) and DIR given).
 file(REMOVE_RECURSE ${DIR})
 file(MAKE_DIRECTORY ${DIR})
@@ -43,6 +44,36 @@ file(SHA256 ${DIR}/resumed-raw.pfm e)
 if(NOT e STREQUAL a)
   message(FATAL_ERROR "resuming a checkpoint with feature sums without --denoise changed the raw image")
 endif()
+
+# --frames writes each frame denoised too (a scene without animations: every frame is den.pfm).
+run(0 ${COMMON} --spp 8 --denoise --frames 2..2 -o "${DIR}/frame_#.pfm")
+file(SHA256 ${DIR}/frame_2.pfm f)
+if(NOT f STREQUAL c)
+  message(FATAL_ERROR "render --frames --denoise wrote another image than render --denoise")
+endif()
+
+# Shards keep the feature sums (version 6 partials); merge adds them and --denoise runs the filter's C++
+# twin on the merged sums: the same image as render --denoise, to float rounding (the twin test measures
+# 2e-6 relative; the merged sums differ from one machine's by rounding too).
+run(0 ${COMMON} --spp 8 --denoise --shard 1/2 -o ${DIR}/s1.ckpt)
+run(0 ${COMMON} --spp 8 --aov albedo --shard 2/2 -o ${DIR}/s2.ckpt)
+file(READ ${DIR}/s1.ckpt head LIMIT 200)
+if(NOT head MATCHES "^CAUSTICA-CKPT 6\n.*\nfeatures 1\n.*\nshard 1/2 0 4 8\n")
+  message(FATAL_ERROR "a shard rendered with --denoise should write a version 6 partial with the feature sums: ${head}")
+endif()
+run_command(merge 0 ${DIR}/s2.ckpt ${DIR}/s1.ckpt --denoise --aov albedo -o ${DIR}/merged-den.pfm -q)
+execute_process(COMMAND ${COMPARE} ${DIR}/merged-den.pfm ${DIR}/den.pfm 1e-4 RESULT_VARIABLE crc OUTPUT_VARIABLE cout)
+if(NOT crc EQUAL 0)
+  message(FATAL_ERROR "merge --denoise of two shards differs from render --denoise: ${cout}")
+endif()
+if(NOT EXISTS ${DIR}/merged-den.albedo.pfm)
+  message(FATAL_ERROR "merge --aov albedo -o merged-den.pfm wrote no merged-den.albedo.pfm")
+endif()
+run(0 ${COMMON} --spp 8 --shard 1/2 -o ${DIR}/p1.ckpt)
+run(0 ${COMMON} --spp 8 --shard 2/2 -o ${DIR}/p2.ckpt)
+refused_command(merge "p1.ckpt: the parts hold no feature sums \\(their shards were rendered without --denoise or --aov\\)"
+                ${DIR}/p1.ckpt ${DIR}/p2.ckpt --denoise -o ${DIR}/x.pfm)
+refused_command(merge "one holds the albedo sums and the other not" ${DIR}/s1.ckpt ${DIR}/p2.ckpt -o ${DIR}/x.pfm)
 
 function(refused pattern)
   run(1 ${ARGN})
