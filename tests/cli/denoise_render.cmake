@@ -45,6 +45,25 @@ if(NOT e STREQUAL a)
   message(FATAL_ERROR "resuming a checkpoint with feature sums without --denoise changed the raw image")
 endif()
 
+# --target-error and adaptive sampling measure the raw image: with --denoise the render takes the same
+# samples (same spp per pixel, same estimate, same stop) and its raw image (--aov raw) is the same bits.
+run(0 ${COMMON} --target-error 0.05 -o ${DIR}/target.pfm --stats ${DIR}/target.json)
+run(0 ${COMMON} --target-error 0.05 --denoise --aov raw -o ${DIR}/target-den.pfm --stats ${DIR}/target-den.json)
+foreach(key spp_min spp_mean spp_max estimated_relmse samples stop)
+  file(READ ${DIR}/target.json ja)
+  file(READ ${DIR}/target-den.json jb)
+  string(JSON va GET "${ja}" ${key})
+  string(JSON vb GET "${jb}" ${key})
+  if(NOT va STREQUAL vb)
+    message(FATAL_ERROR "--target-error with --denoise: ${key} is ${vb}, without ${va}: the budget should see the raw image")
+  endif()
+endforeach()
+file(SHA256 ${DIR}/target.pfm g)
+file(SHA256 ${DIR}/target-den.raw.pfm h)
+if(NOT g STREQUAL h)
+  message(FATAL_ERROR "--target-error with --denoise rendered another raw image than without")
+endif()
+
 # --frames writes each frame denoised too (a scene without animations: every frame is den.pfm).
 run(0 ${COMMON} --spp 8 --denoise --frames 2..2 -o "${DIR}/frame_#.pfm")
 file(SHA256 ${DIR}/frame_2.pfm f)
@@ -75,15 +94,9 @@ refused_command(merge "p1.ckpt: the parts hold no feature sums \\(their shards w
                 ${DIR}/p1.ckpt ${DIR}/p2.ckpt --denoise -o ${DIR}/x.pfm)
 refused_command(merge "one holds the albedo sums and the other not" ${DIR}/s1.ckpt ${DIR}/p2.ckpt -o ${DIR}/x.pfm)
 
-function(refused pattern)
-  run(1 ${ARGN})
-  if(NOT err MATCHES "${pattern}")
-    message(FATAL_ERROR "render ${ARGN}: the refusal does not say '${pattern}': ${err}")
-  endif()
-endfunction()
 run(0 ${COMMON} --spp 4 --checkpoint 1000 -o ${DIR}/plain.pfm)
-refused("plain.pfm.ckpt: has no feature sums \\(it was rendered without --denoise or --aov\\)"
+refused_command(render "plain.pfm.ckpt: has no feature sums \\(it was rendered without --denoise or --aov\\)"
         ${COMMON} --spp 8 --denoise --resume ${DIR}/plain.pfm.ckpt -o ${DIR}/x.pfm)
-refused("--denoise needs the path tracer \\(--mode path\\), not --mode whitted" ${COMMON} --mode whitted --denoise -o ${DIR}/x.png)
-refused("option --aov: unknown feature buffer 'albedos' \\(expected albedo, normal, depth, variance, raw or all\\)"
+refused_command(render "--denoise needs the path tracer \\(--mode path\\), not --mode whitted" ${COMMON} --mode whitted --denoise -o ${DIR}/x.png)
+refused_command(render "option --aov: unknown feature buffer 'albedos' \\(expected albedo, normal, depth, variance, raw or all\\)"
         ${COMMON} --aov normal,albedos -o ${DIR}/x.png)

@@ -181,7 +181,8 @@ void Viewer::present() {
   const bool denoised = showDenoised();
   presenter_.draw(*renderer_, controls_.tone, ww, wh, finishedRows, denoised);
   if (denoised) {  // the denoiser's share of the frame (Renderer::denoiseMs: it waits for the GPU)
-    denoiseMs_ += (denoised_ == 0 ? 1.0 : 0.1) * (renderer_->denoiseMs() - denoiseMs_);
+    // The first run is left out: llvmpipe compiles the programs at their first dispatch (about a second).
+    if (denoised_ > 0) denoiseMs_ += (denoised_ == 1 ? 1.0 : 0.1) * (renderer_->denoiseMs() - denoiseMs_);
     ++denoised_;
   }
   pacer_.recordDisplay((now() - t) * 1000.0, presented_);
@@ -299,7 +300,7 @@ int Viewer::run() {
                 loopPresented / std::max(loopSeconds, 1e-9), static_cast<double>(loopSamples) / std::max(loopSeconds, 1e-9),
                 renderer_->settings().width, renderer_->settings().height, renderer_->samplesPerPixel(),
                 std::isfinite(estimate_) ? format(", relMSE~%.3g", estimate_).c_str() : "",
-                denoised_ > 0 ? format("; denoised, %.1f ms a shown frame", denoiseMs_).c_str() : "; raw");
+                denoised_ > 1 ? format("; denoised, %.1f ms a shown frame", denoiseMs_).c_str() : denoised_ ? "; denoised" : "; raw");
     if (controls_.stopAtTarget && done()) std::printf("target relMSE %.3g reached\n", controls_.targetError);
   }
   if (!config_.screenshotPath.empty()) {
