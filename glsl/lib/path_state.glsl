@@ -31,6 +31,9 @@ struct PathState {
   vec3 mxDir;          // the direction the path took from x, and its solid-angle pdf
   float mxPdf;
 #endif
+#ifdef CAUSTICA_AOV
+  SampleFeatures feat;  // the denoiser's features of this sample (feature_buffers.glsl)
+#endif
 };
 
 // Sample `sampleIndex` (global) of the pixel: its random stream, keyed by (pixel, sample index, seed),
@@ -57,6 +60,9 @@ PathState startPath(uvec2 pixel, uint sampleIndex) {
   s.chain = 0u;
   s.mx = s.mxN = s.mxOrg = s.mxSigma = s.mxDir = vec3(0.0);
   s.mxPdf = 0.0;
+#endif
+#ifdef CAUSTICA_AOV
+  s.feat = noFeatures();
 #endif
 #ifdef CAUSTICA_TRANSPARENT
   gCameraRayMissed = false;
