@@ -624,9 +624,11 @@ Image Renderer::meansOf(const std::vector<float>& rgba) const {
 const GlTexture& Renderer::denoise() {
   if (!canDenoise()) return accum_;
   if (!denoiser_) denoiser_ = std::make_unique<Denoiser>(library_);  // compiles its programs (not timed)
+  glFinish();  // the work queued before (a sample pass) is not the filter's
   const auto t0 = std::chrono::steady_clock::now();
-  const GlTexture& out = denoiser_->run(accum_, albedo_, normal_);
+  const GlTexture& out = denoiser_->run(accum_, albedo_, normal_);  // returns when the GPU is done
   denoiseMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  denoiseMsTotal_ += denoiseMs_;
   return out;
 }
 
