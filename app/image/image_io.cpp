@@ -1,4 +1,4 @@
-// image_io.cpp — PNG through stb_image_write, EXR through tinyexr, PFM by hand.
+// image_io.cpp — PNG through stb_image_write, EXR through OpenEXR (exr_file.h), PFM by hand.
 #include "image/image_io.h"
 
 #include <algorithm>
@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include <stb_image_write.h>
-#include <tinyexr.h>
 
+#include "image/exr_file.h"
 #include "util/error.h"
 
 namespace caustica {
@@ -38,25 +38,27 @@ void writePng(const std::string& path, int width, int height, const std::vector<
 
 namespace {
 
+// RGBA floats, interleaved, of an image with alpha.
+std::vector<float> interleaveAlpha(const Image& img) {
+  const size_t n = static_cast<size_t>(img.width) * img.height;
+  std::vector<float> rgba(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = img.rgb[i * 3 + c];
+    rgba[i * 4 + 3] = img.alpha[i];
+  }
+  return rgba;
+}
+
 void writeExr(const std::string& path, const Image& img) {
-  // tinyexr's SaveEXR takes interleaved RGB(A) floats and writes them as 32-bit float channels.
-  const char* err = nullptr;
-  std::vector<float> rgba;
-  if (!img.alpha.empty()) {  // OpenEXR's convention: colour premultiplied by alpha, which rgb already is
-    const size_t n = static_cast<size_t>(img.width) * img.height;
-    rgba.resize(n * 4);
-    for (size_t i = 0; i < n; ++i) {
-      for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = img.rgb[i * 3 + c];
-      rgba[i * 4 + 3] = img.alpha[i];
-    }
+  // Linear float RGB (+ A: OpenEXR's convention is colour premultiplied by alpha, which rgb already is).
+  ExrLayer main;
+  main.channels = {"R", "G", "B"};
+  main.values = img.rgb;
+  if (!img.alpha.empty()) {
+    main.channels.push_back("A");
+    main.values = interleaveAlpha(img);
   }
-  int rc = rgba.empty() ? SaveEXR(img.rgb.data(), img.width, img.height, 3, 0 /* float, not half */, path.c_str(), &err)
-                        : SaveEXR(rgba.data(), img.width, img.height, 4, 0, path.c_str(), &err);
-  if (rc != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "error " + std::to_string(rc);
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot write EXR (" + msg + ")");
-  }
+  writeExrLayers(path, img.width, img.height, {main});
 }
 
 void writePfm(const std::string& path, const Image& img) {
@@ -70,18 +72,30 @@ void writePfm(const std::string& path, const Image& img) {
 }
 
 Image readExr(const std::string& path) {
-  float* rgba = nullptr;
   int w = 0, h = 0;
-  const char* err = nullptr;
-  if (LoadEXR(&rgba, &w, &h, path.c_str(), &err) != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "unreadable";
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot read EXR (" + msg + ")");
+  const std::vector<ExrLayer> layers = readExrLayers(path, w, h);
+  const ExrLayer* layer = colorLayer(layers);
+  if (!layer) {
+    std::string names;
+    for (const ExrLayer& l : layers)
+      for (const std::string& c : l.channels) names += (names.empty() ? "" : ", ") + (l.name.empty() ? c : l.name + "." + c);
+    throw Error(path + ": the EXR file has no R, G, B or Y channels (it has: " + (names.empty() ? "none" : names) + ")");
   }
-  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
-  for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
-    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = rgba[i * 4 + c];
-  std::free(rgba);
+  const auto find = [&](const char* name) -> int {
+    for (std::size_t c = 0; c < layer->channels.size(); ++c)
+      if (layer->channels[c] == name) return int(c);
+    return -1;
+  };
+  const std::size_t n = layer->channels.size(), pixels = std::size_t(w) * std::size_t(h);
+  const int y = find("Y");
+  const int rgb[3] = {find("R") >= 0 ? find("R") : y, find("G") >= 0 ? find("G") : y, find("B") >= 0 ? find("B") : y};
+  const int a = find("A");
+  Image img{w, h, std::vector<float>(pixels * 3)};
+  if (a >= 0) img.alpha.resize(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer->values[i * n + std::size_t(rgb[c])];
+    if (a >= 0) img.alpha[i] = layer->values[i * n + std::size_t(a)];
+  }
   return img;
 }
 

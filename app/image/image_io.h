@@ -1,5 +1,5 @@
 // image_io.h — linear float images and their files: .png (tone-mapped 8-bit sRGB, + straight alpha),
-// .exr (linear float RGB, + alpha) and .pfm (linear float RGB), chosen by extension. Row 0 is the top.
+// .exr (linear float RGB, + alpha; through OpenEXR, exr_file.h) and .pfm (linear float RGB), chosen by extension. Row 0 is the top.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -27,7 +27,8 @@ void checkImageExtension(const std::string& path);
 // is rgb / alpha, tone-mapped), EXR has an A channel (rgb premultiplied), PFM is refused (no alpha).
 // Throws Error naming the file on failure.
 void writeImage(const std::string& path, const Image& image, const ToneMapSettings& tone = {});
-// Reads a linear .exr or .pfm file.
+// Reads a linear .exr (its colour layer, exr_file.h: R, G, B or Y, and A when present, any compression,
+// half or float) or .pfm file.
 Image readImage(const std::string& path);
 // Writes 8-bit RGB bytes (w*h*3), or RGBA bytes (w*h*4) with channels = 4, as PNG.
 void writePng(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb, int channels = 3);
