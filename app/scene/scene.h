@@ -86,6 +86,19 @@ struct TriangleUv {
   glm::vec2 uv[3]{glm::vec2(0.0f), glm::vec2(0.0f), glm::vec2(0.0f)};
 };
 
+// A triangle's vertex colours: COLOR_0 (linear RGB, and alpha), which multiplies its material's base
+// colour and opacity (glTF 3.7.2.1). White where a primitive has none.
+struct TriangleColors {
+  glm::vec4 color[3]{glm::vec4(1.0f), glm::vec4(1.0f), glm::vec4(1.0f)};
+};
+
+// A triangle's vertex tangents (the file's TANGENT, world space): xyz unit, w the bitangent's sign
+// (bitangent = cross(normal, xyz) * w); (0, 0, 0, 0) where the primitive has none (the normal map then
+// takes the triangle's dp/du).
+struct TriangleTangents {
+  glm::vec4 tangent[3]{glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f)};
+};
+
 // A triangle with positions only: no normals, texture coordinates zero (OBJ meshes, tests, benchmarks).
 inline Triangle makeTriangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, std::uint32_t material = 0) {
   Triangle t{};
@@ -135,6 +148,12 @@ struct Scene {
   // Texture coordinates of triangles[i] at texcoords[i]; empty when no material reads a texture (24 B per
   // triangle saved), else exactly as long as `triangles`. Read them with triangleUv().
   std::vector<TriangleUv> texcoords;
+  // Vertex colours of triangles[i] at colors[i]: empty unless some primitive has COLOR_0 (48 B per
+  // triangle), else exactly as long as `triangles`. Read them with triangleColor().
+  std::vector<TriangleColors> colors;
+  // Vertex tangents of triangles[i] at tangents[i]: empty unless some normal-mapped primitive has
+  // TANGENT, else exactly as long as `triangles`. Read them with triangleTangent().
+  std::vector<TriangleTangents> tangents;
   // Empty unless loaded with LoadOptions::keepInstances: then every triangle belongs to exactly one
   // mesh and the scene is the union of its instances (flattenInstances makes it world space).
   std::vector<MeshRange> meshes;
@@ -159,6 +178,14 @@ struct Scene {
 // Corner k's texture coordinates of triangle i; (0, 0) in a scene that keeps none.
 inline glm::vec2 triangleUv(const Scene& s, std::size_t i, int k) {
   return s.texcoords.empty() ? glm::vec2(0.0f) : s.texcoords[i].uv[k];
+}
+// Corner k's vertex colour (linear RGBA) of triangle i; white in a scene without vertex colours.
+inline glm::vec4 triangleColor(const Scene& s, std::size_t i, int k) {
+  return s.colors.empty() ? glm::vec4(1.0f) : s.colors[i].color[k];
+}
+// Corner k's tangent of triangle i (xyz, sign w); zero in a scene without tangents.
+inline glm::vec4 triangleTangent(const Scene& s, std::size_t i, int k) {
+  return s.tangents.empty() ? glm::vec4(0.0f) : s.tangents[i].tangent[k];
 }
 // Whether a scene with these materials keeps texture coordinates (Scene::texcoords).
 inline bool keepsTexcoords(const std::vector<Material>& materials) {
