@@ -27,19 +27,29 @@ def add_tangents(g, primitive, tangents):
     primitive["attributes"]["TANGENT"] = g.floats(tangents, "VEC4")
 
 
-def bumps_png():
-    """64x64 tangent-space normal map (linear RGB): a grid of round bumps, 16 texels apart."""
+def bumps_png(rotated=False):
+    """64x64 tangent-space normal map (linear RGB): a grid of round bumps, 16 texels apart. rotated:
+    the same normals in a frame turned 90 degrees about the normal (tangent' = bitangent,
+    bitangent' = -tangent: x' = y, y' = -x), for a mesh whose TANGENT is turned likewise."""
+    def encode(v):
+        return int(round((v * 0.5 + 0.5) * 255))
+
     def pixel(x, y):
+        r, g, b = base(x, y)
+        if not rotated:
+            return (encode(r), encode(g), encode(b))
+        return (encode(g), encode(-r), encode(b))
+
+    def base(x, y):
         u, v = (x % 16) - 7.5, (y % 16) - 7.5
         r = math.hypot(u, v)
         if r > 6.0:
-            return (128, 128, 255)
+            return (0.0, 0.0, 1.0)
         # a spherical cap: the normal tilts away from the bump's centre; +y of the map is up in the
         # image (towards -v), glTF's convention
         s = 0.6 * r / 6.0
         nx, ny = s * u / max(r, 1e-6), -s * v / max(r, 1e-6)
-        nz = math.sqrt(max(0.0, 1.0 - nx * nx - ny * ny))
-        return tuple(int(round((c * 0.5 + 0.5) * 255)) for c in (nx, ny, nz))
+        return (nx, ny, math.sqrt(max(0.0, 1.0 - nx * nx - ny * ny)))
     return ma.png_bytes(64, 64, pixel)
 
 
@@ -69,12 +79,14 @@ def compress_source():
     return g.finish()
 
 
-def tangent_source():
+def tangent_source(rotated=False):
     """A normal-mapped sphere whose TANGENT is the mesh's own dp/du (unit, w = 1), lit by a quad
     light: the same image with or without the TANGENT attribute, since caustica's fallback is the
-    triangle's dp/du."""
+    triangle's dp/du. rotated (tangent-rotated.gltf): TANGENT turned 90 degrees about the normal (the
+    bitangent direction) and the map's normals turned to match: the same image, but only when TANGENT
+    is used."""
     g = ma.Gltf()
-    bumps = g.texture_png(bumps_png(), {"magFilter": ma.LINEAR, "minFilter": ma.LINEAR,
+    bumps = g.texture_png(bumps_png(rotated), {"magFilter": ma.LINEAR, "minFilter": ma.LINEAR,
                                         "wrapS": ma.REPEAT, "wrapT": ma.REPEAT})
     floor = g.material("floor", color=(0.6, 0.6, 0.6))
     mesh = ma.MeshData()
@@ -90,7 +102,10 @@ def tangent_source():
         # dp/du of uv_sphere (u = phi / 2 pi, position = r (sin t cos phi, cos t, -sin t sin phi)):
         # along (-sin phi, 0, -cos phi); at the poles any horizontal unit vector.
         phi = math.atan2(-n[2], n[0])
-        tangents.append((ma.clean(-math.sin(phi)), 0.0, ma.clean(-math.cos(phi)), 1.0))
+        t = (-math.sin(phi), 0.0, -math.cos(phi))
+        if rotated:
+            t = ma.normalize(ma.cross(n, t))
+        tangents.append((ma.clean(t[0]), ma.clean(t[1]), ma.clean(t[2]), 1.0))
     for i, uv in enumerate(sphere.uvs):
         sphere.uvs[i] = (uv[0] * 4.0, uv[1] * 2.0)
     bumped = g.material("bumped", color=(0.8, 0.8, 0.8), roughness=0.6)
@@ -214,6 +229,7 @@ def main():
     scenes = {
         "compress-source.gltf": compress_source(),
         "tangent-source.gltf": tangent_source(),
+        "tangent-rotated.gltf": tangent_source(rotated=True),
     }
     for name, doc in scenes.items():
         path = os.path.join(WILD, name)

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <glm/gtc/packing.hpp>
+
 #include "accel/tlas.h"
 #include "scene/caustic_casters.h"
 #include "util/error.h"
@@ -21,6 +23,7 @@ std::vector<std::string> SceneFeatures::defines() const {
   if (dispersion) d.push_back("CAUSTICA_DISPERSION");
   if (textures) d.push_back("CAUSTICA_TEXTURES");
   if (opacity) d.push_back("CAUSTICA_OPACITY");
+  if (vertexColors) d.push_back("CAUSTICA_VERTEX_COLORS");
   if (environment) d.push_back("CAUSTICA_ENV");
   if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
   if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
@@ -39,6 +42,7 @@ std::string SceneFeatures::describe() const {
   add(dispersion, "dispersion");
   add(textures, "textures");
   add(opacity, "opacity");
+  add(vertexColors, "vertex-colors");
   add(environment, "environment");
   add(punctual, "punctual");
   add(spotEmitters, "spot-emitters");
@@ -69,9 +73,10 @@ SceneFeatures sceneFeatures(const Scene& scene) {
                 glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
     f.dispersion |= glass && m.dispersion > 0.0f;
     f.textures |= m.readsTextures();
-    f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture;
+    f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture || (!scene.colors.empty() && m.alphaFromVertices);
     f.ggx |= hasRoughLobe(m);
   }
+  f.vertexColors = !scene.colors.empty();
   f.environment = scene.environment.emits() || scene.background.kind != Background::Kind::Environment;
   f.punctual = !scene.punctualLights.empty();
   for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
@@ -111,6 +116,14 @@ std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, co
   return table;
 }
 
+std::vector<std::string> TriShadeLayout::defines() const {
+  std::vector<std::string> d;
+  if (texcoords) d.push_back("CAUSTICA_TRISHADE_TEXCOORDS");
+  if (colors) d.push_back("CAUSTICA_TRISHADE_COLORS");
+  if (tangents) d.push_back("CAUSTICA_TRISHADE_TANGENTS");
+  return d;
+}
+
 namespace {
 std::uint32_t floatBits(float f) {
   std::uint32_t u;
@@ -118,16 +131,33 @@ std::uint32_t floatBits(float f) {
   return u;
 }
 
-// Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, stride): its octahedral normals, then
-// full-float texcoords only where textures read them (half floats would move a texel on large textures).
-void writeTriShade(const Scene& scene, std::size_t tri, std::uint32_t stride, std::uint32_t* w) {
+// Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, layout.stride()): its octahedral normals,
+// then full-float texcoords only where textures read them (half floats would move a texel on large
+// textures), vertex colours as half floats, tangents octahedral with the sign in bit 0.
+void writeTriShade(const Scene& scene, std::size_t tri, const TriShadeLayout& layout, std::uint32_t* w) {
   for (int k = 0; k < 3; ++k) w[k] = scene.triangles[tri].normalWord[k];  // stored octahedral already (scene.h)
-  if (stride == gpu::kTriShadeWordsTextured)
+  if (layout.texcoords)
     for (int k = 0; k < 3; ++k) {
       const glm::vec2 uv = triangleUv(scene, tri, k);
       w[3 + 2 * k] = floatBits(uv.x);
       w[4 + 2 * k] = floatBits(uv.y);
     }
+  if (layout.colors)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec4 c = triangleColor(scene, tri, k);
+      w[layout.colorOffset() + 2 * std::uint32_t(k)] = glm::packHalf2x16(glm::vec2(c.r, c.g));
+      w[layout.colorOffset() + 2 * std::uint32_t(k) + 1] = glm::packHalf2x16(glm::vec2(c.b, c.a));
+    }
+  if (layout.tangents)
+    for (int k = 0; k < 3; ++k) w[layout.tangentOffset() + std::uint32_t(k)] = tangentWord(triangleTangent(scene, tri, k));
+}
+
+// The TriShade blocks the scene needs; tangents only serve normal maps, which only textured scenes have.
+void setTriShadeLayout(const Scene& scene, GpuScene& g) {
+  g.triShadeLayout.texcoords = g.features.textures;
+  g.triShadeLayout.colors = !scene.colors.empty();
+  g.triShadeLayout.tangents = g.features.textures && !scene.tangents.empty();
+  g.triShadeStride = g.triShadeLayout.stride();
 }
 
 // The environment's texels, CDFs and UBO. An environment lights every point from everywhere, so
@@ -165,7 +195,7 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
     geom[j].v0 = glm::vec4(q0, glm::uintBitsToFloat(t.material));
     geom[j].v1 = glm::vec4(q1, glm::uintBitsToFloat(leaf == gpu::kInvalidIndex ? 0u : leaf + 1u));
     geom[j].v2 = glm::vec4(q2, 0.0f);
-    writeTriShade(scene, bvh.order[i], g.triShadeStride, shade.data() + j * g.triShadeStride);
+    writeTriShade(scene, bvh.order[i], g.triShadeLayout, shade.data() + j * g.triShadeStride);
   }
 }
 
@@ -213,6 +243,13 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
     const auto texIndex = [](int t) { return t >= 0 ? static_cast<std::uint32_t>(t) : gpu::kInvalidIndex; };
     if (m.alphaFromTexture) gm.tex.z |= gpu::kMatAlphaTexture;
     if (m.alphaFromTexture && m.alphaCutoff >= 0.0f) gm.tex.z |= gpu::kMatAlphaMask;
+    if (g.triShadeLayout.colors && m.alphaFromVertices) {  // COLOR_0's alpha joins factor and texture
+      gm.tex.z |= gpu::kMatVertexAlpha;
+      if (m.alphaCutoff >= 0.0f) {  // MASK: thresholded per hit, from the factor's own alpha
+        gm.tex.z |= gpu::kMatAlphaMask;
+        gm.baseColor.a = m.maskAlpha;
+      }
+    }
     gm.specular = glm::vec4(m.specularF0, m.specularF90);
     gm.tex2 = glm::uvec4(texIndex(m.metallicRoughnessTexture), texIndex(m.normalTexture),
                          floatBits(m.normalScale), floatBits(m.alphaCutoff));
@@ -258,7 +295,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triangleCount = bvh.order.size();
-  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  setTriShadeLayout(scene, g);
   packMaterialsAndTextures(scene, g);
 
   // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
@@ -291,7 +328,7 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   if (bvh.triSource.size() != bvh.tris.size()) throw Error("internal: packInstancedScene without triSource");
   GpuScene g;
   g.features = sceneFeatures(scene);
-  g.triShadeStride = g.features.textures ? gpu::kTriShadeWordsTextured : gpu::kTriShadeWords;
+  setTriShadeLayout(scene, g);
   // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
   // the light-leaf table).
   std::vector<std::uint32_t> emissiveIndex(scene.triangles.size(), gpu::kInvalidIndex);
@@ -331,7 +368,7 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     const std::uint32_t i = bvh.triSource[x];
     storedIndex[i] = static_cast<std::uint32_t>(x);
     g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
-    writeTriShade(scene, i, g.triShadeStride, g.triShade.data() + x * g.triShadeStride);
+    writeTriShade(scene, i, g.triShadeLayout, g.triShade.data() + x * g.triShadeStride);
   }
 
   // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
@@ -408,9 +445,20 @@ glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k) {
 }
 
 glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k) {
-  if (g.triShadeStride != gpu::kTriShadeWordsTextured) return glm::vec2(0.0f);
+  if (!g.triShadeLayout.texcoords) return glm::vec2(0.0f);
   const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + 3 + 2 * k;
   return glm::vec2(glm::uintBitsToFloat(w[0]), glm::uintBitsToFloat(w[1]));
+}
+
+glm::vec4 shadeColor(const GpuScene& g, std::size_t tri, int k) {
+  if (!g.triShadeLayout.colors) return glm::vec4(1.0f);
+  const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + g.triShadeLayout.colorOffset() + 2 * k;
+  return glm::vec4(glm::unpackHalf2x16(w[0]), glm::unpackHalf2x16(w[1]));
+}
+
+glm::vec4 shadeTangent(const GpuScene& g, std::size_t tri, int k) {
+  if (!g.triShadeLayout.tangents) return glm::vec4(0.0f);
+  return tangentFromWord(g.triShade[tri * g.triShadeStride + g.triShadeLayout.tangentOffset() + std::size_t(k)]);
 }
 
 std::vector<std::string> GpuScene::instanceDefines() const {

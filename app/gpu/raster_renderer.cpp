@@ -28,7 +28,7 @@ bool isMirrorMaterial(const gpu::Material& m) { return m.params.x >= 0.5f && !is
 
 // Uniform locations (raster.vert / raster.frag / shadow.*).
 constexpr GLint kUViewProj = 0, kUClipPlane = 1, kUEye = 2, kUBaseColor = 3, kUEmission = 4, kUParams = 5,
-                kUHasTexture = 6, kUPlanarMirror = 7, kUShadowTexels = 8, kULightPosFar = 1;
+                kUHasTexture = 6, kUPlanarMirror = 7, kUShadowTexels = 8, kUVertexAlpha = 9, kULightPosFar = 1;
 
 }  // namespace
 
@@ -99,7 +99,7 @@ RasterMesh buildRasterMesh(const GpuScene& scene) {
     const glm::vec2 uv[3] = {shadeUv(scene, i, 0), shadeUv(scene, i, 1), shadeUv(scene, i, 2)};
     for (int k = 0; k < 3; ++k) {
       glm::vec3 ns = glm::length(nn[k]) > 0.5f ? glm::normalize(nn[k]) : geomNormal[i];
-      mesh.vertices.push_back({p[k], ns, uv[k], geomNormal[i]});
+      mesh.vertices.push_back({p[k], ns, uv[k], geomNormal[i], shadeColor(scene, i, k)});
     }
   };
   auto batchesOf = [&](int which, std::vector<RasterMesh::Batch>& out) {
@@ -148,7 +148,7 @@ RasterRenderer::RasterRenderer(const ShaderLibrary& library, const GpuScene& sce
   using V = RasterMesh::Vertex;
   vao_ = GlVertexArray::create(vertexBuffer_, sizeof(V),
                                {{0, 3, offsetof(V, position)}, {1, 3, offsetof(V, normal)}, {2, 2, offsetof(V, uv)},
-                                {3, 3, offsetof(V, geomNormal)}});
+                                {3, 3, offsetof(V, geomNormal)}, {4, 4, offsetof(V, color)}});
   for (const gpu::TexInfo& t : scene.texInfo) {
     auto wrap = [](bool repeat, bool mirror) { return mirror ? GL_MIRRORED_REPEAT : repeat ? GL_REPEAT : GL_CLAMP_TO_EDGE; };
     textures_.push_back(GlTexture::createSrgb8(static_cast<int>(t.width), static_cast<int>(t.height),
@@ -207,6 +207,7 @@ void RasterRenderer::setMaterial(std::uint32_t material, bool planarMirror) cons
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, textured ? textures_[m.tex.x].id() : 0);
   glUniform1i(kUPlanarMirror, planarMirror ? 1 : 0);
+  glUniform1i(kUVertexAlpha, (m.tex.z & gpu::kMatVertexAlpha) != 0u ? 1 : 0);
 }
 
 void RasterRenderer::drawBatches(const std::vector<RasterMesh::Batch>& batches) const {
@@ -251,10 +252,18 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     }
   // With mirrors the reflected scene lies up to twice as far.
   if (!mesh_.mirrors.empty()) far *= 2.0f;
-  glm::mat4 proj = glm::perspective(camera.yfov, static_cast<float>(w) / static_cast<float>(h), far * 1e-4f, far);
+  // An orthographic camera is drawn from far behind its image plane (the same view volume), so that
+  // the shading's view vectors are parallel too.
+  const float aspect = static_cast<float>(w) / static_cast<float>(h);
+  const float back = camera.orthographic() ? 1000.0f * far : 0.0f;
+  const glm::vec3 eye = camera.position - fwd * back;
+  glm::mat4 proj = camera.orthographic()
+                       ? glm::ortho(-camera.orthoHeight * aspect, camera.orthoHeight * aspect, -camera.orthoHeight,
+                                    camera.orthoHeight, back, back + far)
+                       : glm::perspective(camera.yfov, aspect, far * 1e-4f, far);
   // GL's window row 0 is the bottom; the accumulation image's row 0 is the top: flip y in clip space.
   proj = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, -1.0f, 1.0f)) * proj;
-  const glm::mat4 viewProj = proj * glm::lookAt(camera.position, camera.position + fwd, up);
+  const glm::mat4 viewProj = proj * glm::lookAt(eye, eye + fwd, up);
   const glm::vec4 keepAll(0.0f, 0.0f, 0.0f, 1.0f);
 
   GLint viewport[4];
@@ -282,7 +291,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
   glUniform1f(kUShadowTexels, static_cast<float>(kShadowMapTexels));
 
   // 1. The opaque scene; planar mirrors first get a plain surface like everything else.
-  drawOpaqueScene(viewProj, camera.position, keepAll, -1);
+  drawOpaqueScene(viewProj, eye, keepAll, -1);
 
   // 2. Each planar mirror (the paper's method): mark its visible pixels in the stencil buffer, push
   // their depth to the far plane, draw the scene seen by the mirrored camera there (clipped to the
@@ -292,7 +301,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     const RasterMirror& mirror = mesh_.mirrors[k];
     glm::vec3 n = mirror.normal;
     float d = mirror.offset;
-    float side = glm::dot(n, camera.position) - d;
+    float side = glm::dot(n, eye) - d;
     if (std::abs(side) < 1e-6f * far) continue;
     if (side < 0.0f) n = -n, d = -d;  // the plane's normal towards the camera
     const GLint first = static_cast<GLint>(mirror.first);
@@ -301,7 +310,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
 
     glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform4fv(kUClipPlane, 1, glm::value_ptr(keepAll));
-    glUniform3fv(kUEye, 1, glm::value_ptr(camera.position));
+    glUniform3fv(kUEye, 1, glm::value_ptr(eye));
     setMaterial(mirror.material, true);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glDepthMask(GL_FALSE);
@@ -323,7 +332,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r) reflect[c][r] = (c == r ? 1.0f : 0.0f) - 2.0f * n[c] * n[r];
     reflect[3] = glm::vec4(2.0f * d * n, 1.0f);
-    glm::vec3 mirroredEye = glm::vec3(reflect * glm::vec4(camera.position, 1.0f));
+    glm::vec3 mirroredEye = glm::vec3(reflect * glm::vec4(eye, 1.0f));
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthFunc(GL_LESS);
     drawOpaqueScene(viewProj * reflect, mirroredEye, glm::vec4(n, -d), k);
@@ -335,7 +344,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     glBlendFuncSeparate(GL_ONE, GL_CONSTANT_COLOR, GL_ZERO, GL_ONE);
     glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform4fv(kUClipPlane, 1, glm::value_ptr(keepAll));
-    glUniform3fv(kUEye, 1, glm::value_ptr(camera.position));
+    glUniform3fv(kUEye, 1, glm::value_ptr(eye));
     setMaterial(mirror.material, true);
     glDepthFunc(GL_ALWAYS);
     glDrawArrays(GL_TRIANGLES, first, count);
@@ -350,7 +359,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     std::vector<float> dist2(tris);
     for (std::uint32_t t = 0; t < tris; ++t) {
       const auto* v = &mesh_.vertices[mesh_.transparentFirst + 3 * t];
-      glm::vec3 c = (v[0].position + v[1].position + v[2].position) / 3.0f - camera.position;
+      glm::vec3 c = (v[0].position + v[1].position + v[2].position) / 3.0f - eye;
       dist2[t] = glm::dot(c, c);
     }
     std::vector<std::uint32_t> order(tris);
@@ -364,7 +373,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_.id());
     glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform4fv(kUClipPlane, 1, glm::value_ptr(keepAll));
-    glUniform3fv(kUEye, 1, glm::value_ptr(camera.position));
+    glUniform3fv(kUEye, 1, glm::value_ptr(eye));
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     glDepthMask(GL_FALSE);

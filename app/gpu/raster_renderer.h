@@ -33,6 +33,7 @@ struct RasterMesh {
     glm::vec3 normal;      // unit shading normal (the flat normal when the mesh has none)
     glm::vec2 uv;
     glm::vec3 geomNormal;  // unit front-face normal of the triangle
+    glm::vec4 color;       // vertex colour (COLOR_0, linear RGBA; white without)
   };
   struct Batch {
     std::uint32_t material = 0;

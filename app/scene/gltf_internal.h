@@ -167,7 +167,11 @@ class SceneBuilder {
     warn(what);
   }
 
-  void warnUnsupportedExtensions();
+  // Everything the file holds that caustica does not render, as one warning line (gltf_unsupported.cpp);
+  // notRendered adds an entry found elsewhere (a material's textures).
+  void warnNotRendered();
+  void notRendered(const std::string& what);
+  std::vector<std::string> notRendered_;
 
   // ---- materials (gltf_materials.cpp) ----
   double unit(double v, const std::string& what);
@@ -244,12 +248,12 @@ class SceneBuilder {
   std::map<std::pair<int, std::vector<float>>, int> transformMap_;
   int defaultMaterial_ = -1;
   bool keepUv_ = false;          // some material reads a texture: Scene::texcoords kept (keepsTexcoords)
+  bool keepColors_ = false;      // some primitive so far has COLOR_0: Scene::colors kept
+  bool keepTangents_ = false;    // some normal-mapped primitive so far has TANGENT: Scene::tangents kept
   std::size_t degenerate_ = 0;   // zero-area triangles dropped
   std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable
   std::size_t candidates_ = 0;   // triangles assembled so far, degenerate ones included
   std::uint64_t decoded_ = 0;    // accessor elements decoded so far
-  bool warnedSkin_ = false;
-  bool warnedTargets_ = false;
   std::string firstSkip_;  // first reason a primitive was skipped, quoted when nothing is left
   // Instances met in the node walk, converted once the origin is known.
   struct CameraInstance {

@@ -618,7 +618,15 @@ class JsonChecker {
       number(*p, pat, "znear");
       number(*p, pat, "zfar");
     }
-    object(o, at, "orthographic");
+    if (const Json* ortho = object(o, at, "orthographic")) {
+      const std::string oat = join(at, "orthographic");
+      for (const char* key : {"xmag", "ymag"})
+        if (number(*ortho, oat, key, true)->get<double>() == 0.0) fail(join(oat, key) + " is 0; it must not be");
+      const double znear = number(*ortho, oat, "znear", true)->get<double>();
+      const double zfar = number(*ortho, oat, "zfar", true)->get<double>();
+      if (!(znear >= 0.0) || !(zfar > znear))
+        fail(oat + " has znear " + num(znear) + " and zfar " + num(zfar) + "; they must satisfy 0 <= znear < zfar");
+    }
   }
 
   std::string path_;

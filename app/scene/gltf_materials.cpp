@@ -122,13 +122,15 @@ Material SceneBuilder::convertMaterial(int index) {
     base.a = 1.0;
   } else if (m.alphaMode == "MASK") {
     if (!(m.alphaCutoff >= 0.0)) fail(at + ".alphaCutoff is " + num(m.alphaCutoff) + "; it must be >= 0");
-    if (out.baseColorTexture >= 0) out.alphaCutoff = float(m.alphaCutoff);
-    else base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
+    out.alphaCutoff = float(m.alphaCutoff);
+    out.maskAlpha = float(base.a);
+    if (out.baseColorTexture < 0) base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
   } else if (m.alphaMode != "BLEND") {
     fail(at + ".alphaMode is \"" + oneLine(m.alphaMode) + "\"; it must be OPAQUE, BLEND or MASK");
   }
   out.baseColor = glm::vec4(base);
-  out.alphaFromTexture = out.baseColorTexture >= 0 && (m.alphaMode == "BLEND" || m.alphaMode == "MASK");
+  out.alphaFromVertices = m.alphaMode == "BLEND" || m.alphaMode == "MASK";
+  out.alphaFromTexture = out.baseColorTexture >= 0 && out.alphaFromVertices;
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength = radiance (linear).
   glm::dvec3 emissive(0.0);
@@ -206,7 +208,7 @@ Material SceneBuilder::convertMaterial(int index) {
     if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
     else out.dispersion = float(dispersion);
   }
-  if (!ignored.empty()) warn(at + " '" + oneLine(out.name) + "': ignoring unsupported " + ignored);
+  if (!ignored.empty()) notRendered(at + " '" + oneLine(out.name) + "': " + ignored);
   // Triangles carry one UV set, so a material's textures must agree on theirs (TEXCOORD_0 or _1).
   if (materialTexCoords_.size() == 1 && (*materialTexCoords_.begin() == 0 || *materialTexCoords_.begin() == 1)) {
     out.texCoord = *materialTexCoords_.begin();

@@ -20,7 +20,6 @@
 namespace caustica::gltf {
 
 void SceneBuilder::build() {
-  warnUnsupportedExtensions();
   quantized_ = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), "KHR_mesh_quantization") !=
                model_.extensionsUsed.end();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
@@ -41,6 +40,7 @@ void SceneBuilder::build() {
   if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
   if (badNormals_ > 0)
     warn(str(badNormals_) + " triangle(s) had zero or non-finite vertex normals; flat normals used for them");
+  warnNotRendered();
   if (scene_.triangles.empty()) {
     std::string why = firstSkip_;
     if (why.empty() && degenerate_ > 0) why = "all " + str(degenerate_) + " triangles have zero area";
@@ -61,12 +61,6 @@ void SceneBuilder::build() {
   }
 }
 
-void SceneBuilder::warnUnsupportedExtensions() {
-  std::string list;
-  for (const std::string& ext : model_.extensionsUsed)
-    if (!isSupportedExtension(ext)) list += (list.empty() ? "" : ", ") + oneLine(ext);
-  if (!list.empty()) warn("ignoring unsupported extension(s): " + list);
-}
 
 namespace {
 // Triangles a primitive declares (accessor counts; 0 for other modes or bad indices, reported later).
@@ -227,10 +221,6 @@ void SceneBuilder::traverse() {
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
         if (!std::isfinite(xf.world[c][r])) fail(at + ": its world transform is not finite");
-    if (node.skin >= 0 && !warnedSkin_) {
-      warn(at + ": skins are not supported; meshes are drawn in their bind pose");
-      warnedSkin_ = true;
-    }
     if (node.camera >= 0) cameraInstances_.push_back({node.camera, index, xf.world, at});
     if (const int light = nodeLight(node); light >= 0) lightInstances_.push_back({light, index, xf.world, at});
     if (node.mesh >= 0) {
@@ -355,13 +345,14 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
          " cameras");
   const tinygltf::Camera& cam = model_.cameras[std::size_t(index)];
   const std::string cat = "cameras[" + str(std::uint64_t(index)) + "]";
-  if (cam.type != "perspective") {
-    warn(cat + " is " + oneLine(cam.type) + "; only perspective cameras are used");
-    return;
-  }
-  const double yfov = cam.perspective.yfov;
-  if (!(yfov > 0.0 && yfov < kPiD))
+  const bool orthographic = cam.type == "orthographic";
+  const double yfov = orthographic ? 0.7 : cam.perspective.yfov;
+  if (!orthographic && !(yfov > 0.0 && yfov < kPiD))
     fail(cat + ".perspective.yfov is " + num(yfov) + "; it must be an angle in radians between 0 and pi");
+  // glTF's xmag and ymag are half the view's width and height (checkJson: finite, not 0; their sign
+  // carries no meaning here).
+  const double ymag = orthographic ? std::abs(cam.orthographic.ymag) : 0.0;
+  const double xmag = orthographic ? std::abs(cam.orthographic.xmag) : 0.0;
   const glm::dmat3 m3(world);
   const glm::dvec3 position = glm::dvec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0)) - origin_;
   const glm::dvec3 f = m3 * glm::dvec3(0.0, 0.0, -1.0);
@@ -381,6 +372,13 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
   out.up = glm::vec3(upOrtho / ul);
   out.yfov = float(yfov);
   out.aspect = cam.perspective.aspectRatio > 0.0 ? float(cam.perspective.aspectRatio) : 0.0f;
+  if (orthographic) {
+    // The node's scale does not scale the view (glTF 3.10.3: camera transforms exclude scale).
+    out.orthoHeight = float(ymag);
+    out.aspect = float(xmag / ymag);
+    if (!std::isfinite(out.orthoHeight) || !std::isfinite(out.aspect) || !(out.orthoHeight > 0.0f))
+      fail(cat + ".orthographic: xmag and ymag must be finite and not 0");
+  }
   scene_.cameras.push_back(out);
 }
 
@@ -425,10 +423,6 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
     skip(at + ": mode " + std::to_string(prim.mode) + " is not a valid primitive mode; primitive skipped");
     return;
-  }
-  if (!prim.targets.empty() && !warnedTargets_) {
-    warn(at + ": morph targets are not supported; the base shape is used");
-    warnedTargets_ = true;
   }
   if (prim.attributes.find("POSITION") == prim.attributes.end()) {
     skip(at + " has no POSITION attribute; primitive skipped");
@@ -517,14 +511,16 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     colors = readAttribute(prim, "COLOR_0", type, attributeFormats(VertexAttribute::Color, quantized_), vertexCount, at);
     for (std::size_t i = 0; i < colors.size(); ++i)
       if (!std::isfinite(colors[i])) fail(at + ": COLOR_0 of vertex " + str(i / std::size_t(colorComponents)) + " is not finite");
-    if (scene_.colors.empty()) scene_.colors.resize(scene_.triangles.size());  // white before the first
+    if (!keepColors_) scene_.colors.resize(scene_.triangles.size());  // white before the first
+    keepColors_ = true;
   }
   // TANGENT (VEC4: xyz and the bitangent's sign) orients the material's normal map, when it has one.
   std::vector<double> tangents;
   if (scene_.materials[material].normalTexture >= 0 && prim.attributes.count("TANGENT")) {
     tangents = readAttribute(prim, "TANGENT", TINYGLTF_TYPE_VEC4, attributeFormats(VertexAttribute::Tangent, quantized_),
                              vertexCount, at);
-    if (scene_.tangents.empty()) scene_.tangents.resize(scene_.triangles.size());  // none before the first
+    if (!keepTangents_) scene_.tangents.resize(scene_.triangles.size());  // none before the first
+    keepTangents_ = true;
   }
   const auto tangentAt = [&](std::size_t i) -> glm::vec4 {  // world space; 0 where unusable
     const glm::dvec3 t = glm::dmat3(xf.world) * glm::dvec3(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
@@ -574,9 +570,9 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       finite = finite && std::isfinite(tri.p[k].x) && std::isfinite(tri.p[k].y) && std::isfinite(tri.p[k].z);
       uv.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
       if (!colors.empty()) {
-        const std::size_t n = std::size_t(colorComponents);
-        color.color[k] = glm::vec4(float(colors[n * i]), float(colors[n * i + 1]), float(colors[n * i + 2]),
-                                   n == 4 ? float(colors[n * i + 3]) : 1.0f);
+        const std::size_t cn = std::size_t(colorComponents);
+        color.color[k] = glm::vec4(float(colors[cn * i]), float(colors[cn * i + 1]), float(colors[cn * i + 2]),
+                                   cn == 4 ? float(colors[cn * i + 3]) : 1.0f);
       }
       if (!tangents.empty()) tangent.tangent[k] = tangentAt(i);
     }
@@ -601,8 +597,8 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     }
     scene_.triangles.push_back(tri);
     if (keepUv_) scene_.texcoords.push_back(uv);
-    if (!scene_.colors.empty()) scene_.colors.push_back(color);
-    if (!scene_.tangents.empty()) scene_.tangents.push_back(tangent);
+    if (keepColors_) scene_.colors.push_back(color);
+    if (keepTangents_) scene_.tangents.push_back(tangent);
   }
 }
 

@@ -48,7 +48,11 @@ struct Material {
   float specularF90 = 0.0f;
   int texCoord = 0;                   // the UV set (TEXCOORD_0 or TEXCOORD_1) every texture of the material reads
   bool alphaFromTexture = false;      // BLEND or MASK with a base-colour texture: its alpha multiplies baseColor.a
+  bool alphaFromVertices = false;     // BLEND or MASK: COLOR_0's alpha multiplies baseColor.a (vertex colours)
   float alphaCutoff = -1.0f;          // alphaMode MASK: opaque where alpha >= cutoff, else absent; < 0: not MASK
+  // MASK: baseColorFactor's alpha. Without a texture baseColor.a holds it already thresholded (0 or 1);
+  // with vertex colours the threshold is taken per hit, of maskAlpha x COLOR_0's alpha.
+  float maskAlpha = 1.0f;
   float transmission = 0.0f;          // KHR_materials_transmission: dielectric weight in [0,1]
   float ior = 1.5f;                   // KHR_materials_ior, at 587.6 nm
   float dispersion = 0.0f;            // KHR_materials_dispersion (20 / Abbe number), 0 = none
@@ -109,14 +113,18 @@ inline Triangle makeTriangle(const glm::vec3& a, const glm::vec3& b, const glm::
   return t;
 }
 
-// Pinhole camera. Looks down -Z of its node in glTF; here stored in world space.
+// Pinhole or orthographic camera. Looks down -Z of its node in glTF; here stored in world space.
 struct Camera {
   std::string name;
   glm::vec3 position{0.0f};
   glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit
   glm::vec3 up{0.0f, 1.0f, 0.0f};        // unit, orthogonal to forward
-  float yfov = 0.7f;                      // vertical field of view, radians
+  float yfov = 0.7f;                      // vertical field of view, radians (pinhole)
   float aspect = 0.0f;                    // width / height from the file; 0 = take it from the image
+  // Orthographic (glTF's ymag): half the image's height in scene units; rays leave the image plane
+  // through `position` along `forward`, the width following the image's aspect. 0: a pinhole camera.
+  float orthoHeight = 0.0f;
+  bool orthographic() const { return orthoHeight > 0.0f; }
 };
 
 struct Bounds {
