@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "scene/obj_mesh.h"
 #include "util/error.h"
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/intersect.h"
 #include "accel/bvh_wide.h"
 #include "accel/ray_box.h"
 #include "scene/assets.h"

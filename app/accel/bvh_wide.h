@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/intersect.h"
 #include "shared/gpu_layout.h"
 
 namespace caustica {

@@ -1,4 +1,4 @@
-// gpu_scene.cpp — Scene + BVH to shader storage arrays; emitter alias table; feature detection.
+// gpu_scene.cpp — Scene + BVH to shader storage arrays; the emitters' light tree.
 #include "accel/gpu_scene.h"
 
 #include <cmath>
@@ -6,6 +6,7 @@
 
 #include <glm/gtc/packing.hpp>
 
+#include "accel/intersect.h"
 #include "accel/tlas.h"
 #include "scene/caustic_casters.h"
 #include "util/error.h"
@@ -15,41 +16,6 @@
 
 namespace caustica {
 
-std::vector<std::string> SceneFeatures::defines() const {
-  std::vector<std::string> d;
-  if (mirror) d.push_back("CAUSTICA_MIRROR");
-  if (glass) d.push_back("CAUSTICA_GLASS");
-  if (volume) d.push_back("CAUSTICA_VOLUME");
-  if (dispersion) d.push_back("CAUSTICA_DISPERSION");
-  if (textures) d.push_back("CAUSTICA_TEXTURES");
-  if (opacity) d.push_back("CAUSTICA_OPACITY");
-  if (vertexColors) d.push_back("CAUSTICA_VERTEX_COLORS");
-  if (environment) d.push_back("CAUSTICA_ENV");
-  if (punctual) d.push_back("CAUSTICA_PUNCTUAL");
-  if (spotEmitters) d.push_back("CAUSTICA_SPOT_EMITTERS");
-  if (ggx) d.push_back("CAUSTICA_GGX");
-  return d;
-}
-
-std::string SceneFeatures::describe() const {
-  std::string s;
-  auto add = [&](bool on, const char* name) {
-    if (on) s += (s.empty() ? "" : " ") + std::string(name);
-  };
-  add(mirror, "mirror");
-  add(glass, "glass");
-  add(volume, "volume");
-  add(dispersion, "dispersion");
-  add(textures, "textures");
-  add(opacity, "opacity");
-  add(vertexColors, "vertex-colors");
-  add(environment, "environment");
-  add(punctual, "punctual");
-  add(spotEmitters, "spot-emitters");
-  add(ggx, "ggx");
-  return s.empty() ? "diffuse only" : s;
-}
-
 bool hasRoughLobe(const Material& m) {
   const bool rough = m.roughness * m.roughness >= kDeltaAlpha || m.metallicRoughnessTexture >= 0;
   const bool metal = m.metallic > 0.0f || m.metallicRoughnessTexture >= 0;
@@ -58,62 +24,11 @@ bool hasRoughLobe(const Material& m) {
   return (rough && (metal || glass)) || layered;
 }
 
-SceneFeatures sceneFeatures(const Scene& scene) {
+std::vector<bool> usedMaterials(const Scene& scene) {
   std::vector<bool> used(scene.materials.size(), false);
   for (const auto& t : scene.triangles)
     if (t.material < used.size()) used[t.material] = true;
-  SceneFeatures f;
-  for (size_t i = 0; i < scene.materials.size(); ++i) {
-    if (!used[i]) continue;
-    const Material& m = scene.materials[i];
-    f.mirror |= m.metallic > 0.0f;
-    bool glass = m.transmission > 0.0f && m.metallic < 1.0f;
-    f.glass |= glass;
-    f.volume |= glass && std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f &&
-                glm::any(glm::lessThan(m.attenuationColor, glm::vec3(1.0f)));
-    f.dispersion |= glass && m.dispersion > 0.0f;
-    f.textures |= m.readsTextures();
-    f.opacity |= m.baseColor.a < 1.0f || m.alphaFromTexture || (!scene.colors.empty() && m.alphaFromVertices);
-    f.ggx |= hasRoughLobe(m);
-  }
-  f.vertexColors = !scene.colors.empty();
-  f.environment = scene.environment.emits() || scene.background.kind != Background::Kind::Environment;
-  f.punctual = !scene.punctualLights.empty();
-  for (const SpotEmitter& e : scene.spotEmitters) f.spotEmitters |= e.material < used.size() && used[e.material];
-  return f;
-}
-
-std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items) {
-  size_t n = weights.size();
-  std::vector<gpu::Emitter> table(n);
-  double total = 0.0;
-  for (double w : weights) total += w;
-  if (n == 0 || !(total > 0.0)) return {};
-  std::vector<double> scaled(n);
-  std::vector<size_t> small, large;
-  for (size_t i = 0; i < n; ++i) {
-    scaled[i] = weights[i] * static_cast<double>(n) / total;
-    (scaled[i] < 1.0 ? small : large).push_back(i);
-    table[i].tri = items[i];
-    table[i].pdfSelect = static_cast<float>(weights[i] / total);
-    table[i].alias = static_cast<std::uint32_t>(i);
-    table[i].prob = 1.0f;
-  }
-  while (!small.empty() && !large.empty()) {
-    size_t s = small.back(), l = large.back();
-    small.pop_back();
-    table[s].prob = static_cast<float>(scaled[s]);
-    table[s].alias = static_cast<std::uint32_t>(l);
-    scaled[l] -= 1.0 - scaled[s];
-    if (scaled[l] < 1.0) {
-      large.pop_back();
-      small.push_back(l);
-    }
-  }
-  // Leftovers are 1 up to rounding.
-  for (size_t i : small) table[i].prob = 1.0f;
-  for (size_t i : large) table[i].prob = 1.0f;
-  return table;
+  return used;
 }
 
 std::vector<std::string> TriShadeLayout::defines() const {
@@ -129,6 +44,18 @@ std::uint32_t floatBits(float f) {
   std::uint32_t u;
   std::memcpy(&u, &f, sizeof u);
   return u;
+}
+
+// The TriShade blocks the scene needs: full-float texcoords where a material some triangle uses reads
+// a texture (the CAUSTICA_TEXTURES row of gpu/shader_features.cpp asks the same of the materials),
+// vertex colours where the scene has them, tangents where it has them and textures (normal maps).
+void setTriShadeLayout(const Scene& scene, GpuScene& g) {
+  const std::vector<bool> used = usedMaterials(scene);
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    g.triShadeLayout.texcoords = g.triShadeLayout.texcoords || (used[m] && scene.materials[m].readsTextures());
+  g.triShadeLayout.colors = !scene.colors.empty();
+  g.triShadeLayout.tangents = g.triShadeLayout.texcoords && !scene.tangents.empty();
+  g.triShadeStride = g.triShadeLayout.stride();
 }
 
 // Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, layout.stride()): its octahedral normals,
@@ -150,14 +77,6 @@ void writeTriShade(const Scene& scene, std::size_t tri, const TriShadeLayout& la
     }
   if (layout.tangents)
     for (int k = 0; k < 3; ++k) w[layout.tangentOffset() + std::uint32_t(k)] = tangentWord(triangleTangent(scene, tri, k));
-}
-
-// The TriShade blocks the scene needs; tangents only serve normal maps, which only textured scenes have.
-void setTriShadeLayout(const Scene& scene, GpuScene& g) {
-  g.triShadeLayout.texcoords = g.features.textures;
-  g.triShadeLayout.colors = !scene.colors.empty();
-  g.triShadeLayout.tangents = g.features.textures && !scene.tangents.empty();
-  g.triShadeStride = g.triShadeLayout.stride();
 }
 
 // The environment's texels, CDFs and UBO. An environment lights every point from everywhere, so
@@ -218,8 +137,8 @@ LightTreeItem emitterItem(std::uint32_t tri, const glm::vec3* p, double power, b
   return item;
 }
 
-// What packScene and packInstancedScene share: features, environment, materials, punctual lights,
-// textures (not the triangles, the casters or the emitters).
+// What packScene and packInstancedScene share: environment, materials, punctual lights, textures
+// (not the triangles, the casters or the emitters).
 void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
   if (!scene.texcoords.empty() && scene.texcoords.size() != scene.triangles.size())
     throw Error("internal: Scene::texcoords is neither empty nor one per triangle");
@@ -263,7 +182,6 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
     gm.tex.z |= gpu::kMatSpotEmitter;
   }
   g.punctual = packPunctualLights(scene.punctualLights, scene.bounds, scene.path);
-  g.features.punctual = g.punctual.count.x > 0;
 
   for (const Texture& t : scene.textures) {
     gpu::TexInfo info{};
@@ -289,7 +207,6 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   GpuScene g;
-  g.features = sceneFeatures(scene);
   g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
   g.emitterSphere = emitterBoundingSphere(scene);
   packEnvironment(scene, g);
@@ -299,8 +216,6 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   packMaterialsAndTextures(scene, g);
 
   // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
-  std::vector<double> weights;
-  std::vector<std::uint32_t> tris;
   double totalWeight = 0.0;
   std::vector<LightTreeItem> lightItems;
   for (size_t i = 0; i < g.triangleCount; ++i) {
@@ -309,25 +224,22 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
     if (!m.isEmissive()) continue;
     const double w = emitterWeight(m, tri.p);  // tri.p: TriGeom's vertices
     if (w == 0.0) continue;
-    weights.push_back(w);
-    tris.push_back(static_cast<std::uint32_t>(i));
     totalWeight += w;
     lightItems.push_back(emitterItem(static_cast<std::uint32_t>(i), tri.p, w, m.doubleSided));
   }
   // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
   // TriGeom.v1.w (leaf index + 1 as uint bits, 0: not in the tree).
+  g.emitterCount = lightItems.size();
   g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
   if (triangleArrays) packTriangleRange(scene, bvh, g, 0, g.triangleCount, g.triGeom, g.triShade);
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
-  g.emitters = buildAliasTable(weights, tris);
   return g;
 }
 
 GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   if (bvh.triSource.size() != bvh.tris.size()) throw Error("internal: packInstancedScene without triSource");
   GpuScene g;
-  g.features = sceneFeatures(scene);
   setTriShadeLayout(scene, g);
   // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
   // the light-leaf table).
@@ -372,8 +284,6 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   }
 
   // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
-  std::vector<double> weights;
-  std::vector<std::uint32_t> items;
   std::vector<LightTreeItem> lightItems;
   double totalWeight = 0.0;
   for (std::size_t e = 0; e < lights.triangles.size(); ++e) {
@@ -382,17 +292,15 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     if (!m.isEmissive()) continue;
     const double w = emitterWeight(m, tri.p);
     if (w == 0.0) continue;
-    weights.push_back(w);
-    items.push_back(static_cast<std::uint32_t>(lightItems.size()));
     totalWeight += w;
     lightItems.push_back(emitterItem(storedIndex[source[e].triangle], tri.p, w, m.doubleSided));
     lightItems.back().instance = source[e].instance;
   }
+  g.emitterCount = lightItems.size();
   g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);  // per stored triangle: meaningless here
   g.totalEmitterWeight = static_cast<float>(totalWeight);
   g.totalPower = kPi * totalWeight;
-  g.emitters = buildAliasTable(weights, items);
 
   // The light-leaf table: per instance of an emissive mesh, its emitters' leaves in emissiveIndex order.
   std::vector<std::uint32_t> leafBase(scene.instances.size(), 0);

@@ -1,5 +1,5 @@
-// gpu_scene.h — packs a Scene and its BVH into the arrays the shaders read (gpu_layout.h), builds
-// the emitter alias table, and decides which shader features the scene needs.
+// gpu_scene.h — packs a Scene and its BVH into the arrays the shaders read (gpu_layout.h) and builds
+// the light tree over the emitters. (Which shader features a scene needs: gpu/shader_features.h.)
 #pragma once
 #include <cstdint>
 #include <string>
@@ -13,27 +13,18 @@
 
 namespace caustica {
 
-// What the scene's materials need; each maps to one CAUSTICA_* shader define.
-struct SceneFeatures {
-  bool mirror = false, glass = false, volume = false, dispersion = false, textures = false, opacity = false;
-  bool vertexColors = false;  // COLOR_0 on some triangle: CAUSTICA_VERTEX_COLORS (they multiply the base colour)
-  bool environment = false;  // an environment that emits, or a background other than it (CAUSTICA_ENV)
-  bool punctual = false;      // KHR_lights_punctual lights: CAUSTICA_PUNCTUAL (their NEE, in both integrators)
-  bool spotEmitters = false;  // --light-radius spheres of spot lights: CAUSTICA_SPOT_EMITTERS
-  bool ggx = false;  // a rough metal or glass, or a specular layer over a diffuse base (CAUSTICA_GGX)
-  std::vector<std::string> defines() const;  // material defines only (not integrator or dispersion mode)
-  std::string describe() const;              // e.g. "mirror glass dispersion" or "diffuse only"
-};
-SceneFeatures sceneFeatures(const Scene& scene);
+// Per material of `scene`: whether some triangle uses it (a material no triangle uses switches no
+// shader feature on and adds no texcoords to the TriShade words).
+std::vector<bool> usedMaterials(const Scene& scene);
 // True when the material has a GGX lobe: a metal or glass part with roughness^2 >= kDeltaAlpha (or a
 // metallicRoughness texture), or a diffuse part with a specular layer (specularF90 > 0).
 bool hasRoughLobe(const Material& m);
 
 // Which optional blocks the TriShade words of each triangle hold (gpu_layout.h), and where.
 struct TriShadeLayout {
-  bool texcoords = false;  // the material UV set (textured scenes)
+  bool texcoords = false;  // the material UV set (a used material reads a texture)
   bool colors = false;     // COLOR_0 as half floats (Scene::colors not empty)
-  bool tangents = false;   // TANGENT, octahedral (Scene::tangents not empty and the scene textured)
+  bool tangents = false;   // TANGENT, octahedral (Scene::tangents not empty, and texcoords)
   std::uint32_t colorOffset() const { return gpu::kTriShadeWords + (texcoords ? gpu::kTriShadeTexcoordWords : 0u); }
   std::uint32_t tangentOffset() const { return colorOffset() + (colors ? gpu::kTriShadeColorWords : 0u); }
   std::uint32_t stride() const { return tangentOffset() + (tangents ? gpu::kTriShadeTangentWords : 0u); }
@@ -49,7 +40,7 @@ struct GpuScene {
   TriShadeLayout triShadeLayout;        // the blocks those words hold
   std::uint32_t triShadeStride = gpu::kTriShadeWords;  // triShadeLayout.stride()
   std::vector<gpu::Material> materials;
-  std::vector<gpu::Emitter> emitters;   // alias table, one slot per emissive triangle (host only: counts, info)
+  std::size_t emitterCount = 0;         // emissive triangles of positive power: the light tree's leaves
   LightTree lightTree;                  // light tree over the same triangles: what the shaders sample (binding 4)
   std::vector<std::uint32_t> texels;    // RGBA8 packed as unpackUnorm4x8 reads them
   std::vector<gpu::TexInfo> texInfo;
@@ -58,7 +49,6 @@ struct GpuScene {
   std::vector<CausticCaster> casters;   // caustic casters (findCausticCasters), at most CAUSTICA_MAX_CASTERS
   glm::vec4 emitterSphere{0.0f, 0.0f, 0.0f, -1.0f};  // around every emitter (emitterBoundingSphere)
   gpu::PunctualParams punctual{};       // punctual lights and their selection probabilities (a UBO)
-  SceneFeatures features;
   // The environment map and its sampling CDFs (width 0: no environment light).
   EnvironmentDistribution environment;
   gpu::EnvironmentParams environmentParams{};  // the UBO: map size, rotation, background
@@ -99,8 +89,5 @@ struct GpuSceneBytes {
   std::size_t total() const { return nodes + triGeom + triShade + materials + lightTree + textures; }
 };
 GpuSceneBytes gpuSceneBytes(const GpuScene& g);
-
-// Vose's alias table over `weights` (non-negative, not all zero). Slot i holds item `items[i]`.
-std::vector<gpu::Emitter> buildAliasTable(const std::vector<double>& weights, const std::vector<std::uint32_t>& items);
 
 }  // namespace caustica

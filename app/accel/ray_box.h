@@ -1,5 +1,5 @@
 // ray_box.h — the ray/box guards and the binary node visit shared by the one- and two-level C++ traversals
-// (bvh.cpp, tlas.cpp).
+// (bvh_traverse.cpp, tlas.cpp).
 // Twins of safeInverse() and intersectAabb() in glsl/lib/intersect.glsl; distances in units of |dir|.
 #pragma once
 

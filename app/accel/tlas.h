@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/intersect.h"
 #include "shared/gpu_layout.h"
 #include "scene/scene.h"
 

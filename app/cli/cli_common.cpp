@@ -115,9 +115,7 @@ double Options::getDouble(const std::string& name, double fallback) const {
 std::vector<OptionSpec> sceneOptionSpecs() {
   std::vector<OptionSpec> specs = {
       {"--size", "", "W[xH]", "image size in pixels (default 512; H follows the camera's aspect)"},
-      {"--mode", "", "MODE",
-       "path (the path tracer; default), whitted (ray tracer: point lights, mirrors, glass, no GI) or raster "
-       "(OpenGL raster pipeline) (docs/render-modes.md)"},
+      {"--mode", "", "MODE", renderModeHelp()},
       {"--seed", "", "S", "random seed (default 1); the same seed gives the same image"},
       {"--integrator", "", "NAME", "naive (BSDF sampling only) or mis (light sampling + MIS; default)"},
       {"--dispersion", "", "MODE", "rgb (one channel per path; default) or spectral (hero wavelength)"},
@@ -314,15 +312,16 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
   return ls;
 }
 
-void flattenForRaster(Scene& scene, const Options& opts, bool quiet) {
-  if (scene.instances.empty()) return;
+void flattenForMode(Scene& scene, RenderMode mode, const Options& opts, bool quiet) {
+  const RenderModeSpec& spec = renderModeSpec(mode);
+  if (scene.instances.empty() || spec.instancedScenes) return;
   const std::uint64_t placed = instancedTriangleCount(scene);
   const std::uint64_t limit = loadOptionsFrom(opts).maxTriangles;
   if (placed > limit)
-    throw Error(scene.path + ": the raster mode draws flattened scenes, and flattening its " +
+    throw Error(scene.path + ": the " + spec.name + " mode draws flattened scenes, and flattening its " +
                 std::to_string(scene.instances.size()) + " instances makes " + std::to_string(placed) +
                 " triangles, more than the limit of " + std::to_string(limit) + " (use --max-triangles to raise it)");
-  note(quiet, "raster mode: " + std::to_string(scene.instances.size()) + " instances flattened into " +
+  note(quiet, std::string(spec.name) + " mode: " + std::to_string(scene.instances.size()) + " instances flattened into " +
                   std::to_string(placed) + " triangles");
   flattenInstances(scene);
 }

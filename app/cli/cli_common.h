@@ -74,9 +74,10 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
 // The same for the command's one positional scene argument (default: the bundled default scene).
 LoadedScene loadSceneForCli(const Options& opts, bool verbose, int defaultWidth = 512);
 int cameraIndexFrom(const Options& opts);  // --camera N, default 0
-// The raster mode draws flat scenes only: bakes an instanced scene's instances on the host
-// (flattenInstances), or refuses (Error) when that would exceed --max-triangles.
-void flattenForRaster(Scene& scene, const Options& opts, bool quiet);
+// For a mode that draws flat scenes only (RenderModeSpec::instancedScenes false: raster), bakes an
+// instanced scene's instances on the host (flattenInstances), or refuses (Error) when that would
+// exceed --max-triangles. Does nothing otherwise.
+void flattenForMode(Scene& scene, RenderMode mode, const Options& opts, bool quiet);
 
 ShaderLibrary shaderLibraryFrom(const Options& opts);
 

@@ -44,7 +44,7 @@ int cmdCompare(const std::vector<std::string>& args) {
   checkWritableFile(out, "output");
 
   LoadedScene ls = loadSceneForCli(opts, !quiet, 384);
-  flattenForRaster(ls.scene, opts, quiet);  // one scene for the three modes; raster draws flat ones
+  for (const RenderModeSpec& m : renderModes()) flattenForMode(ls.scene, m.mode, opts, quiet);  // one scene for every mode
   RenderSettings settings = ls.settings.render;
   const ToneMapSettings& tone = ls.settings.tone;
   std::string glInfo;
@@ -55,21 +55,23 @@ int cmdCompare(const std::vector<std::string>& args) {
   Renderer renderer(library, ls.scene, ls.camera, settings);
 
   std::vector<ComparePanel> panels;
+  // The paper's order, from the fewest effects to all of them (compare_figure.cpp's table has a column each).
   for (RenderMode mode : {RenderMode::Raster, RenderMode::Whitted, RenderMode::Path}) {
+    const RenderModeSpec& spec = renderModeSpec(mode);
     settings.mode = mode;
     renderer.apply(settings);  // compiles the mode's shaders (not timed)
     // Drivers compile at the first dispatch or draw (llvmpipe: about a second): one row first, so
     // the time is the render's alone.
     renderer.renderRows(0, 1, 1);
     renderer.reset();
-    const int n = mode == RenderMode::Raster ? 1 : mode == RenderMode::Whitted ? whittedSpp : spp;
+    const int n = spec.samples == SampleRule::OneFrame ? 1 : spec.pathTracer ? spp : whittedSpp;
     auto t0 = std::chrono::steady_clock::now();
     renderWithProgress(renderer, n, renderModeName(mode), quiet);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ComparePanel p;
     p.label = renderModeName(mode);
     char detail[96];
-    if (mode == RenderMode::Raster)
+    if (spec.samples == SampleRule::OneFrame)
       std::snprintf(detail, sizeof detail, "1 frame, %.1f ms", seconds * 1000.0);
     else
       std::snprintf(detail, sizeof detail, "%d spp, %.2f s", n, seconds);

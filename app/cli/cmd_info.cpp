@@ -13,6 +13,7 @@
 #include "util/error.h"
 #include "accel/gpu_scene.h"
 #include "accel/tlas.h"
+#include "gpu/shader_features.h"
 #include "shading/microfacet.h"
 
 namespace caustica::cli {
@@ -72,9 +73,9 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("triangles:  %zu\n", s.triangles.size());
   std::printf("instances:  %s\n", instanced ? (instancesSummary(g) + " of " + std::to_string(s.meshes.size()) + " meshes").c_str()
                                             : instancesSummary(g).c_str());
-  std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitters.size(),
+  std::printf("emitters:   %zu triangles, total power %.4g (radiance x area x pi, scene units)\n", g.emitterCount,
               g.totalPower);
-  std::printf("lighting:   %s\n", lightingSummary(s, g.emitters.size()).c_str());
+  std::printf("lighting:   %s\n", lightingSummary(s, g.emitterCount).c_str());
   // KHR_lights_punctual, with their share of the light choices (by power, punctual_lights.h).
   std::printf("punctual:   %zu light(s)%s\n", s.punctualLights.size(),
               s.punctualLights.empty() ? "" : " (point/spot: intensity in cd; directional: lux; chosen by power)");
@@ -133,14 +134,15 @@ int cmdInfo(const std::vector<std::string>& args) {
               hostPeakSummary(s.triangles.size()).c_str());
   std::printf("load:       parse %.2f s, BVH %.2f s, pack %.2f s (upload and first sample: render's load line)\n",
               parseSeconds, buildSeconds, packSeconds);
-  std::printf("features:   %s\n", g.features.describe().c_str());
+  const FeatureSet features = detectFeatures(s, g).only(FeatureKind::Scene);  // shader_features.cpp
+  std::printf("features:   %s\n", features.describe().c_str());
   if (g.casters.empty()) std::printf("casters:    none (no glass or mirror object)\n");
   for (size_t i = 0; i < g.casters.size(); ++i)
     std::printf("%s %s sphere at %s, radius %.3g\n", i == 0 ? "casters:   " : "           ",
                 g.casters[i].refractive ? "glass " : "mirror", vec(glm::vec3(g.casters[i].sphere)).c_str(),
                 g.casters[i].sphere.w);
   std::string defines;
-  for (const auto& d : g.features.defines()) defines += " " + d;
+  for (const auto& d : features.defines()) defines += " " + d;
   for (const auto& d : g.instanceDefines()) defines += " " + d;  // the two-level traversal, as the renderer adds it
   std::printf("defines:   %s\n", defines.empty() ? " (none)" : defines.c_str());
   for (const auto& w : s.warnings) std::printf("warning:    %s\n", w.c_str());

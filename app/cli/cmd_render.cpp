@@ -82,7 +82,7 @@ int cmdRender(const std::vector<std::string>& args) {
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   const RenderSettings& settings = ls.settings.render;
   const ToneMapSettings& tone = ls.settings.tone;
-  if (settings.mode == RenderMode::Raster) flattenForRaster(ls.scene, opts, quiet);  // cli_common.h
+  flattenForMode(ls.scene, settings.mode, opts, quiet);  // raster draws flat scenes (cli_common.h)
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
   note(quiet, "settings: " + settingsSummary(ls.settings));
@@ -98,10 +98,10 @@ int cmdRender(const std::vector<std::string>& args) {
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
-                  std::to_string(renderer.gpuScene().emitters.size()) + " emissive, features: " +
-                  renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
+                  std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
+                  renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
                   std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
-                  (settings.mode == RenderMode::Path ? integratorName(settings.integrator) : renderModeName(settings.mode)));
+                  (renderModeSpec(settings.mode).pathTracer ? integratorName(settings.integrator) : renderModeName(settings.mode)));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);
     note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");

@@ -20,12 +20,13 @@ std::vector<OptionSpec> environmentOptionSpecs() {
 }
 
 namespace {
-// The raster and Whitted modes light with the emitters only (docs/render-modes.md): say so when
-// the environment is all the light there is.
+// Modes that do not see the environment (RenderModeSpec::seesEnvironment: raster, Whitted; docs/render-modes.md)
+// light with the emitters only: say so when the environment is all the light there is.
 void noteModeWithoutEnvironment(RenderMode mode, const Scene& scene, bool verbose) {
-  if (mode != RenderMode::Path && scene.environment.emits())
+  if (!renderModeSpec(mode).seesEnvironment && scene.environment.emits())
     note(!verbose, std::string("warning: the image will be black: --mode ") + renderModeName(mode) +
-                       " does not see the environment yet and " + scene.path + " has no emitters (use --mode path)");
+                       " does not see the environment yet and " + scene.path + " has no emitters (use --mode " +
+                       renderModeNames([](const RenderModeSpec& m) { return m.seesEnvironment; }) + ")");
 }
 }  // namespace
 
@@ -33,8 +34,9 @@ void applyEnvironmentSettings(const ImageSettings& settings, Scene& scene, bool 
   const SceneSettings& s = settings.scene;
   const RenderMode mode = settings.render.mode;
   scene.background = parseBackground(s.background);
-  if (scene.background.kind == Background::Kind::Transparent && mode == RenderMode::Raster)
-    note(!verbose, "warning: --mode raster draws an opaque image: --background transparent needs --mode path or whitted");
+  if (scene.background.kind == Background::Kind::Transparent && !renderModeSpec(mode).tracksCoverage)
+    note(!verbose, std::string("warning: --mode ") + renderModeName(mode) + " draws an opaque image: --background transparent needs --mode " +
+                       renderModeNames([](const RenderModeSpec& m) { return m.tracksCoverage; }));
   scene.environment = Environment{};
   const bool emitters = sceneHasLights(scene);  // emissive triangles (the environment is not set yet)
   if (s.env != "auto") {

@@ -217,13 +217,19 @@ void RasterRenderer::drawBatches(const std::vector<RasterMesh::Batch>& batches) 
   }
 }
 
+// The view uniforms: clip-space transform, the clip plane (a fragment at p is kept where
+// dot(clip.xyz, p) + clip.w >= 0; world space) and the eye.
+void RasterRenderer::setView(const glm::mat4& viewProj, const glm::vec3& eye, const glm::vec4& clip) const {
+  glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
+  glUniform4fv(kUClipPlane, 1, glm::value_ptr(clip));
+  glUniform3fv(kUEye, 1, glm::value_ptr(eye));
+}
+
 // Everything opaque: diffuse and curved metal, emitters, and the planar mirrors other than
 // `skipMirror` as plain surfaces (a mirror seen in a mirror shows no second reflection).
 void RasterRenderer::drawOpaqueScene(const glm::mat4& viewProj, const glm::vec3& eye, const glm::vec4& clip,
                                      int skipMirror) const {
-  glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
-  glUniform4fv(kUClipPlane, 1, glm::value_ptr(clip));
-  glUniform3fv(kUEye, 1, glm::value_ptr(eye));
+  setView(viewProj, eye, clip);
   drawBatches(mesh_.opaque);
   drawBatches(mesh_.emissive);
   for (int k = 0; k < static_cast<int>(mesh_.mirrors.size()); ++k) {
@@ -233,42 +239,40 @@ void RasterRenderer::drawOpaqueScene(const glm::mat4& viewProj, const glm::vec3&
   }
 }
 
-void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
-  const int w = target.width(), h = target.height();
-  if (depthStencil_.width() != w || depthStencil_.height() != h) depthStencil_ = GlTexture::createDepthStencil(w, h);
-  framebuffer_ = GlFramebuffer::forTargets(target, depthStencil_);  // cheap; the target may be new
+namespace {
 
+// The clip-space transform of `camera` for a w x h image (row 0 at the top, as the accumulation image),
+// its far plane beyond everything in `mesh` (twice that with mirrors: the reflected scene lies up to
+// twice as far).
+// The camera's view-projection and `eye`, the point the shading's view vectors start from: the camera's
+// position, or for an orthographic camera a point far behind its image plane (drawn from there with
+// the same view volume, so that the view vectors are parallel too).
+glm::mat4 cameraViewProjection(const Camera& camera, int w, int h, const RasterMesh& mesh, float& far, glm::vec3& eye) {
   // The compute camera's frame: right = forward x up, image row 0 at the top.
   glm::vec3 fwd = glm::normalize(camera.forward);
   glm::vec3 right = glm::normalize(glm::cross(fwd, camera.up));
   glm::vec3 up = glm::cross(right, fwd);
   Bounds b;
-  for (const auto& v : mesh_.vertices) b.grow(v.position);
-  float far = 1.0f;
+  for (const auto& v : mesh.vertices) b.grow(v.position);
+  far = 1.0f;
   if (!b.empty())
     for (int c = 0; c < 8; ++c) {
       glm::vec3 corner((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y, (c & 4) ? b.max.z : b.min.z);
       far = std::max(far, glm::length(corner - camera.position) * 1.01f);
     }
-  // With mirrors the reflected scene lies up to twice as far.
-  if (!mesh_.mirrors.empty()) far *= 2.0f;
-  // An orthographic camera is drawn from far behind its image plane (the same view volume), so that
-  // the shading's view vectors are parallel too.
-  const float aspect = static_cast<float>(w) / static_cast<float>(h);
+  if (!mesh.mirrors.empty()) far *= 2.0f;
+  const float aspect = static_cast<float>(w) / static_cast<float>(h), h2 = camera.orthoHeight;
   const float back = camera.orthographic() ? 1000.0f * far : 0.0f;
-  const glm::vec3 eye = camera.position - fwd * back;
-  glm::mat4 proj = camera.orthographic()
-                       ? glm::ortho(-camera.orthoHeight * aspect, camera.orthoHeight * aspect, -camera.orthoHeight,
-                                    camera.orthoHeight, back, back + far)
-                       : glm::perspective(camera.yfov, aspect, far * 1e-4f, far);
+  eye = camera.position - fwd * back;
+  glm::mat4 proj = camera.orthographic() ? glm::ortho(-h2 * aspect, h2 * aspect, -h2, h2, back, back + far)
+                                         : glm::perspective(camera.yfov, aspect, far * 1e-4f, far);
   // GL's window row 0 is the bottom; the accumulation image's row 0 is the top: flip y in clip space.
   proj = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, -1.0f, 1.0f)) * proj;
-  const glm::mat4 viewProj = proj * glm::lookAt(eye, eye + fwd, up);
-  const glm::vec4 keepAll(0.0f, 0.0f, 0.0f, 1.0f);
+  return proj * glm::lookAt(eye, eye + fwd, up);
+}
 
-  GLint viewport[4];
-  glGetIntegerv(GL_VIEWPORT, viewport);
-  framebuffer_.bindDraw();
+// Clears the bound framebuffer (black, alpha 1; depth 1; stencil 0) and sets the state of the opaque pass.
+void beginRasterFrame(int w, int h) {
   glViewport(0, 0, w, h);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
@@ -283,7 +287,25 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
   glDisable(GL_BLEND);
   glDisable(GL_STENCIL_TEST);
   glEnable(GL_CLIP_DISTANCE0);
+}
 
+// Keeps every fragment (the clip plane's distance is always 1).
+const glm::vec4 kKeepAll(0.0f, 0.0f, 0.0f, 1.0f);
+
+}  // namespace
+
+void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
+  const int w = target.width(), h = target.height();
+  if (depthStencil_.width() != w || depthStencil_.height() != h) depthStencil_ = GlTexture::createDepthStencil(w, h);
+  framebuffer_ = GlFramebuffer::forTargets(target, depthStencil_);  // cheap; the target may be new
+  float far = 1.0f;
+  glm::vec3 eye;
+  const glm::mat4 viewProj = cameraViewProjection(camera, w, h, mesh_, far, eye);
+
+  GLint viewport[4];
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  framebuffer_.bindDraw();
+  beginRasterFrame(w, h);
   program_.use();
   vao_.bind();
   glActiveTexture(GL_TEXTURE1);
@@ -291,109 +313,109 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
   glUniform1f(kUShadowTexels, static_cast<float>(kShadowMapTexels));
 
   // 1. The opaque scene; planar mirrors first get a plain surface like everything else.
-  drawOpaqueScene(viewProj, eye, keepAll, -1);
-
-  // 2. Each planar mirror (the paper's method): mark its visible pixels in the stencil buffer, push
-  // their depth to the far plane, draw the scene seen by the mirrored camera there (clipped to the
-  // mirror's front), then lay the mirror's tint and own shading over it and restore its depth.
+  drawOpaqueScene(viewProj, eye, kKeepAll, -1);
+  // 2. Each planar mirror, inside its stencil mask.
   glEnable(GL_STENCIL_TEST);
-  for (int k = 0; k < static_cast<int>(mesh_.mirrors.size()); ++k) {
-    const RasterMirror& mirror = mesh_.mirrors[k];
-    glm::vec3 n = mirror.normal;
-    float d = mirror.offset;
-    float side = glm::dot(n, eye) - d;
-    if (std::abs(side) < 1e-6f * far) continue;
-    if (side < 0.0f) n = -n, d = -d;  // the plane's normal towards the camera
-    const GLint first = static_cast<GLint>(mirror.first);
-    const GLsizei count = static_cast<GLsizei>(mirror.count);
-    const GLint ref = k + 1;
-
-    glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
-    glUniform4fv(kUClipPlane, 1, glm::value_ptr(keepAll));
-    glUniform3fv(kUEye, 1, glm::value_ptr(eye));
-    setMaterial(mirror.material, true);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glDepthMask(GL_FALSE);
-    glDepthFunc(GL_LEQUAL);
-    glStencilFunc(GL_ALWAYS, ref, 0xff);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-    glDrawArrays(GL_TRIANGLES, first, count);
-
-    glStencilFunc(GL_EQUAL, ref, 0xff);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-    glDepthMask(GL_TRUE);
-    glDepthFunc(GL_ALWAYS);
-    glDepthRange(1.0, 1.0);
-    glDrawArrays(GL_TRIANGLES, first, count);
-    glDepthRange(0.0, 1.0);
-
-    // Reflection in the plane n.x = d: x' = x - 2 (n.x - d) n.
-    glm::mat4 reflect(1.0f);
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) reflect[c][r] = (c == r ? 1.0f : 0.0f) - 2.0f * n[c] * n[r];
-    reflect[3] = glm::vec4(2.0f * d * n, 1.0f);
-    glm::vec3 mirroredEye = glm::vec3(reflect * glm::vec4(eye, 1.0f));
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthFunc(GL_LESS);
-    drawOpaqueScene(viewProj * reflect, mirroredEye, glm::vec4(n, -d), k);
-
-    const gpu::Material& m = materials_[mirror.material];
-    glm::vec3 tint = glm::vec3(m.baseColor) * m.params.x;
-    glEnable(GL_BLEND);
-    glBlendColor(tint.r, tint.g, tint.b, 1.0f);
-    glBlendFuncSeparate(GL_ONE, GL_CONSTANT_COLOR, GL_ZERO, GL_ONE);
-    glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
-    glUniform4fv(kUClipPlane, 1, glm::value_ptr(keepAll));
-    glUniform3fv(kUEye, 1, glm::value_ptr(eye));
-    setMaterial(mirror.material, true);
-    glDepthFunc(GL_ALWAYS);
-    glDrawArrays(GL_TRIANGLES, first, count);
-    glDisable(GL_BLEND);
-    glDepthFunc(GL_LESS);
-  }
+  for (int k = 0; k < static_cast<int>(mesh_.mirrors.size()); ++k) drawPlanarMirror(k, viewProj, eye, far);
   glDisable(GL_STENCIL_TEST);
+  // 3. Glass and cut-outs, back to front, blended over what lies behind.
+  if (mesh_.transparentCount) drawTransparent(viewProj, eye);
 
-  // 3. Glass and cut-outs, back to front, blended over what lies behind (premultiplied; alpha stays 1).
-  if (mesh_.transparentCount) {
-    const std::uint32_t tris = mesh_.transparentCount / 3;
-    std::vector<float> dist2(tris);
-    for (std::uint32_t t = 0; t < tris; ++t) {
-      const auto* v = &mesh_.vertices[mesh_.transparentFirst + 3 * t];
-      glm::vec3 c = (v[0].position + v[1].position + v[2].position) / 3.0f - eye;
-      dist2[t] = glm::dot(c, c);
-    }
-    std::vector<std::uint32_t> order(tris);
-    std::iota(order.begin(), order.end(), 0u);
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b2) { return dist2[a] > dist2[b2]; });
-    std::vector<std::uint32_t> indices;
-    indices.reserve(3 * tris);
-    for (std::uint32_t t : order)
-      for (std::uint32_t k = 0; k < 3; ++k) indices.push_back(mesh_.transparentFirst + 3 * t + k);
-    indexBuffer_ = GlBuffer::fromVector(indices, GL_STREAM_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_.id());
-    glUniformMatrix4fv(kUViewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
-    glUniform4fv(kUClipPlane, 1, glm::value_ptr(keepAll));
-    glUniform3fv(kUEye, 1, glm::value_ptr(eye));
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
-    glDepthMask(GL_FALSE);
-    for (std::uint32_t start = 0; start < tris;) {  // runs of one material
-      std::uint32_t mat = mesh_.transparentMaterial[order[start]], end = start;
-      while (end < tris && mesh_.transparentMaterial[order[end]] == mat) ++end;
-      setMaterial(mat, false);
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * (end - start)), GL_UNSIGNED_INT,
-                     reinterpret_cast<const void*>(static_cast<std::size_t>(start) * 3 * sizeof(std::uint32_t)));
-      start = end;
-    }
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
-  }
   glDisable(GL_CLIP_DISTANCE0);
   glDisable(GL_DEPTH_TEST);  // leave the state the compute passes and the viewer's blit expect
   glBindVertexArray(0);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
   glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
   checkGlError("raster frame");
+}
+
+// Planar mirror k (the paper's method): mark its visible pixels in the stencil buffer, push their depth
+// to the far plane, draw the scene seen by the mirrored camera there (clipped to the mirror's front),
+// then lay the mirror's tint and own shading over it and restore its depth. Stencil test enabled.
+void RasterRenderer::drawPlanarMirror(int k, const glm::mat4& viewProj, const glm::vec3& eye, float far) const {
+  const RasterMirror& mirror = mesh_.mirrors[k];
+  glm::vec3 n = mirror.normal;
+  float d = mirror.offset;
+  float side = glm::dot(n, eye) - d;
+  if (std::abs(side) < 1e-6f * far) return;
+  if (side < 0.0f) n = -n, d = -d;  // the plane's normal towards the camera
+  const GLint first = static_cast<GLint>(mirror.first);
+  const GLsizei count = static_cast<GLsizei>(mirror.count);
+  const GLint ref = k + 1;
+
+  setView(viewProj, eye, kKeepAll);
+  setMaterial(mirror.material, true);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_FALSE);
+  glDepthFunc(GL_LEQUAL);
+  glStencilFunc(GL_ALWAYS, ref, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glDrawArrays(GL_TRIANGLES, first, count);
+
+  glStencilFunc(GL_EQUAL, ref, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_ALWAYS);
+  glDepthRange(1.0, 1.0);
+  glDrawArrays(GL_TRIANGLES, first, count);
+  glDepthRange(0.0, 1.0);
+
+  // Reflection in the plane n.x = d: x' = x - 2 (n.x - d) n.
+  glm::mat4 reflect(1.0f);
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) reflect[c][r] = (c == r ? 1.0f : 0.0f) - 2.0f * n[c] * n[r];
+  reflect[3] = glm::vec4(2.0f * d * n, 1.0f);
+  glm::vec3 mirroredEye = glm::vec3(reflect * glm::vec4(eye, 1.0f));
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthFunc(GL_LESS);
+  drawOpaqueScene(viewProj * reflect, mirroredEye, glm::vec4(n, -d), k);
+
+  const gpu::Material& m = materials_[mirror.material];
+  glm::vec3 tint = glm::vec3(m.baseColor) * m.params.x;
+  glEnable(GL_BLEND);
+  glBlendColor(tint.r, tint.g, tint.b, 1.0f);
+  glBlendFuncSeparate(GL_ONE, GL_CONSTANT_COLOR, GL_ZERO, GL_ONE);
+  setView(viewProj, eye, kKeepAll);
+  setMaterial(mirror.material, true);
+  glDepthFunc(GL_ALWAYS);
+  glDrawArrays(GL_TRIANGLES, first, count);
+  glDisable(GL_BLEND);
+  glDepthFunc(GL_LESS);
+}
+
+// Glass and cut-outs: their triangles sorted back to front by centroid, drawn in runs of one material,
+// blended over what lies behind (premultiplied; alpha stays 1), without writing depth.
+void RasterRenderer::drawTransparent(const glm::mat4& viewProj, const glm::vec3& eye) {
+  const std::uint32_t tris = mesh_.transparentCount / 3;
+  std::vector<float> dist2(tris);
+  for (std::uint32_t t = 0; t < tris; ++t) {
+    const auto* v = &mesh_.vertices[mesh_.transparentFirst + 3 * t];
+    glm::vec3 c = (v[0].position + v[1].position + v[2].position) / 3.0f - eye;
+    dist2[t] = glm::dot(c, c);
+  }
+  std::vector<std::uint32_t> order(tris);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b2) { return dist2[a] > dist2[b2]; });
+  std::vector<std::uint32_t> indices;
+  indices.reserve(3 * tris);
+  for (std::uint32_t t : order)
+    for (std::uint32_t k = 0; k < 3; ++k) indices.push_back(mesh_.transparentFirst + 3 * t + k);
+  indexBuffer_ = GlBuffer::fromVector(indices, GL_STREAM_DRAW);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_.id());
+  setView(viewProj, eye, kKeepAll);
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  glDepthMask(GL_FALSE);
+  for (std::uint32_t start = 0; start < tris;) {  // runs of one material
+    std::uint32_t mat = mesh_.transparentMaterial[order[start]], end = start;
+    while (end < tris && mesh_.transparentMaterial[order[end]] == mat) ++end;
+    setMaterial(mat, false);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * (end - start)), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(static_cast<std::size_t>(start) * 3 * sizeof(std::uint32_t)));
+    start = end;
+  }
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
 }
 
 }  // namespace caustica

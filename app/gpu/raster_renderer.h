@@ -62,7 +62,10 @@ class RasterRenderer {
   void drawShadowMaps(const gpu::PointLights& lights);
   void setMaterial(std::uint32_t material, bool planarMirror) const;
   void drawBatches(const std::vector<RasterMesh::Batch>& batches) const;
+  void setView(const glm::mat4& viewProj, const glm::vec3& eye, const glm::vec4& clip) const;
   void drawOpaqueScene(const glm::mat4& viewProj, const glm::vec3& eye, const glm::vec4& clip, int skipMirror) const;
+  void drawPlanarMirror(int k, const glm::mat4& viewProj, const glm::vec3& eye, float far) const;
+  void drawTransparent(const glm::mat4& viewProj, const glm::vec3& eye);
 
   std::vector<gpu::Material> materials_;
   RasterMesh mesh_;

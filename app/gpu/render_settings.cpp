@@ -21,17 +21,6 @@ DispersionMode parseDispersionMode(const std::string& name) {
   throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
 }
 
-RenderMode parseRenderMode(const std::string& name) {
-  if (name == "path") return RenderMode::Path;
-  if (name == "whitted") return RenderMode::Whitted;
-  if (name == "raster") return RenderMode::Raster;
-  throw Error("unknown render mode '" + name + "' (expected path, whitted or raster)");
-}
-
-const char* renderModeName(RenderMode m) {
-  return m == RenderMode::Path ? "path" : m == RenderMode::Whitted ? "whitted" : "raster";
-}
-
 const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
 const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
 

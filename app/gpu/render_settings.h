@@ -6,17 +6,13 @@
 #include <string>
 #include <type_traits>
 
+#include "gpu/render_mode.h"  // RenderMode: one row per mode
 #include "util/field_count.h"
 
 namespace caustica {
 
 enum class Integrator { Naive, Mis };
 enum class DispersionMode { Rgb, Spectral };
-// How the image is made (docs/render-modes.md): the path tracer, a Whitted ray tracer (compute
-// shader, point lights, mirrors and glass, no global illumination) or the OpenGL raster pipeline.
-enum class RenderMode { Path, Whitted, Raster };
-RenderMode parseRenderMode(const std::string& name);          // "path" | "whitted" | "raster"; throws Error otherwise
-const char* renderModeName(RenderMode m);
 Integrator parseIntegrator(const std::string& name);          // "naive" | "mis"; throws Error otherwise
 DispersionMode parseDispersionMode(const std::string& name);  // "rgb" | "spectral"; throws Error otherwise
 const char* integratorName(Integrator i);

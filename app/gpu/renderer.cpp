@@ -65,8 +65,50 @@ gpu::PointLights pointLightParams(const std::vector<LightGroup>& groups, const s
 
 Renderer::~Renderer() = default;
 
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// World-space bounds of everything in the binary tree (empty for an empty tree).
+Bounds treeBounds(const std::vector<gpu::BvhNode>& nodes) {
+  Bounds b;
+  glm::vec3 lo, hi;
+  if (bvhBounds(nodes, lo, hi)) {
+    b.grow(lo);
+    b.grow(hi);
+  }
+  return b;
+}
+
+}  // namespace
+
 Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
     : library_(library), settings_(settings), camera_(camera) {
+  checkLimits();
+  created_ = std::chrono::steady_clock::now();
+  memTrace("renderer start");
+  std::vector<gpu::BvhWideNode> wideNodes = buildScene(scene);
+  const Bounds sceneBounds = treeBounds(gpuScene_.nodes);
+  planBuffers(scene);
+  const auto t0 = std::chrono::steady_clock::now();
+  uploadScene(scene, std::move(wideNodes));
+  createUniformBuffers();
+  uploadLights(scene, sceneBounds);
+  glFinish();
+  load_.upload = secondsSince(t0);
+  memTrace("upload done");
+  transparent_ = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
+  allocateImages();
+  const auto t1 = std::chrono::steady_clock::now();
+  prepareMode();  // compile now, so shader errors surface before rendering starts
+  load_.compile = secondsSince(t1);
+  memTrace("compiled");
+  load_.ready = secondsSince(created_);
+}
+
+void Renderer::checkLimits() {
   limits_ = queryGlLimits();
   if (limits_.maxComputeStorageBlocks < CAUSTICA_SSBO_COUNT)
     throw Error("this GPU allows " + std::to_string(limits_.maxComputeStorageBlocks) +
@@ -75,17 +117,14 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     throw Error("this GPU's compute work groups are too small");
   settings_.validate();
   checkImageSize(limits_, settings_.width, settings_.height);
-  created_ = std::chrono::steady_clock::now();
-  const auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
+}
+
+std::vector<gpu::BvhWideNode> Renderer::buildScene(const Scene& scene) {
   auto t0 = std::chrono::steady_clock::now();
-  const bool instanced = !scene.instances.empty();
-  memTrace("renderer start");
   std::vector<gpu::BvhWideNode> wideNodes;  // what traverse.glsl reads in flat scenes
-  if (instanced) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
+  if (!scene.instances.empty()) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
     InstancedBvh ib = buildInstancedBvh(scene);
-    bvhSeconds_ = load_.bvh = since(t0);
+    bvhSeconds_ = load_.bvh = secondsSince(t0);
     bvh_.depth = ib.depth;
     t0 = std::chrono::steady_clock::now();
     gpuScene_ = packInstancedScene(scene, ib);
@@ -93,7 +132,7 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     const BvhShape shape = bvhShapeFromEnv();
     bvh_ = buildBvh(scene.triangles, shape.build);
     memTrace("bvh built");
-    bvhSeconds_ = load_.bvh = since(t0);
+    bvhSeconds_ = load_.bvh = secondsSince(t0);
     t0 = std::chrono::steady_clock::now();
     std::vector<gpu::BvhNode> nodes = std::move(bvh_.nodes);  // moved, not copied (packScene copies them)
     bvh_.nodes.clear();
@@ -102,26 +141,27 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
     wideNodes = packBvhWideNodes(gpuScene_.nodes, shape.collapse).nodes;
     memTrace("wide nodes");
   }
-  load_.pack = since(t0);
+  load_.pack = secondsSince(t0);
+  sceneFeatures_ = detectFeatures(scene, gpuScene_);
+  return wideNodes;
+}
 
+void Renderer::planBuffers(const Scene& scene) {
   GpuScene& g = gpuScene_;
-  Bounds sceneBounds;
-  glm::vec3 bvhLo, bvhHi;
-  if (bvhBounds(g.nodes, bvhLo, bvhHi)) {
-    sceneBounds.grow(bvhLo);
-    sceneBounds.grow(bvhHi);
-  }
   // Flat scenes trace through the 4-wide nodes only (traverse.glsl), so the binary node buffer keeps
   // just the root there (~32 B per triangle less on the GPU). Instanced scenes trace the binary
   // two-level BVH (nodes, then instance records) and get an empty wide tree.
-  if (!instanced) {  // released, not only resized: the binary nodes' memory is free before the upload
+  if (scene.instances.empty()) {  // released, not only resized: the binary nodes' memory is free before the upload
     std::vector<gpu::BvhNode> root(g.nodes.begin(), g.nodes.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(g.nodes.size()), 1));
     g.nodes.swap(root);
   }
   bufferLayout_ = planSceneBuffers(g, limits_, scene.path);  // throws before anything is uploaded
   gpuBytes_ = gpuSceneBytes(g);
+}
+
+void Renderer::uploadScene(const Scene& scene, std::vector<gpu::BvhWideNode> wideNodes) {
+  GpuScene& g = gpuScene_;
   gpuBytes_.nodes += wideNodes.size() * sizeof(gpu::BvhWideNode);
-  t0 = std::chrono::steady_clock::now();
   // The 4-wide nodes go up first and their host copy is freed before the triangle records' blocks are
   // made, so the two copies of the nodes and the triangle blocks are never held at once (on llvmpipe
   // the "GPU" copy is host memory: docs/big-scenes.md).
@@ -144,11 +184,17 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   // Host copies the GPU holds now: the BVH's order (its statistics stay), the leaf map.
   std::vector<std::uint32_t>().swap(bvh_.order);
   std::vector<std::uint32_t>().swap(g.lightTree.leafOf);
+}
+
+void Renderer::createUniformBuffers() {
   frameUbo_ = GlBuffer::create(sizeof(gpu::FrameParams), nullptr, GL_DYNAMIC_DRAW);
   casterUbo_ = GlBuffer::create(sizeof(gpu::CasterParams), nullptr, GL_DYNAMIC_DRAW);
-  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &g.punctual, GL_STATIC_DRAW);
+  punctualUbo_ = GlBuffer::create(sizeof(gpu::PunctualParams), &gpuScene_.punctual, GL_STATIC_DRAW);
   uploadCasters();
-  if (instanced) {  // the point lights of Whitted and raster: from world-space copies of the emissive meshes
+}
+
+void Renderer::uploadLights(const Scene& scene, const Bounds& sceneBounds) {
+  if (!scene.instances.empty()) {  // the point lights of Whitted and raster: from world-space copies of the emissive meshes
     std::vector<bool> emissive(scene.materials.size());
     for (std::size_t m = 0; m < scene.materials.size(); ++m) emissive[m] = scene.materials[m].isEmissive();
     lightGroups_ = groupEmitters(flattenedSubset(scene, emissive), CAUSTICA_MAX_POINT_LIGHTS);
@@ -157,25 +203,16 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   }
   pointLights_ = pointLightParams(lightGroups_, scene.punctualLights, sceneBounds);
   pointLightUbo_ = GlBuffer::create(sizeof pointLights_, &pointLights_, GL_STATIC_DRAW);
-  environment_.upload(g, limits_, scene.path);
-  glFinish();
-  load_.upload = since(t0);
-  memTrace("upload done");
-  transparent_ = g.environmentParams.size.z == gpu::kBackgroundTransparent;
-  allocateImages();
-  t0 = std::chrono::steady_clock::now();
-  prepareMode();  // compile now, so shader errors surface before rendering starts
-  load_.compile = since(t0);
-  memTrace("compiled");
-  load_.ready = since(created_);
+  environment_.upload(gpuScene_, limits_, scene.path);
 }
 
 void Renderer::prepareMode() {
-  if (settings_.mode != RenderMode::Raster) {
+  const RenderModeSpec& mode = renderModeSpec(settings_.mode);
+  if (!mode.instancedScenes && gpuScene_.instanceCount > 0)
+    throw Error(std::string(mode.name) + " mode draws flattened scenes only: load this scene with --instances off");
+  if (mode.entryShader) {
     program();
   } else if (!raster_) {
-    if (gpuScene_.instanceCount > 0)
-      throw Error("raster mode draws flattened scenes only: load this scene with --instances off");
     downloadSceneArrays(gpuScene_, bufferLayout_, buffers_);  // the raster mesh is built from them
     raster_ = std::make_unique<RasterRenderer>(library_, gpuScene_, pointLights_);
     std::vector<gpu::TriGeom>().swap(gpuScene_.triGeom);
@@ -183,40 +220,20 @@ void Renderer::prepareMode() {
   }
 }
 
-namespace {
-// Every material feature define, for RenderSettings::allFeatures (the unspecialised shader).
-std::vector<std::string> allMaterialFeatureDefines() {
-  SceneFeatures f;
-  f.mirror = f.glass = f.volume = f.dispersion = f.textures = f.opacity = f.vertexColors = true;
-  f.environment = f.punctual = f.spotEmitters = f.ggx = true;
-  return f.defines();
-}
-}  // namespace
-
 std::vector<std::string> Renderer::shaderDefines() const {
-  std::vector<std::string> d = gpuScene_.features.defines();
-  if (settings_.allFeatures && settings_.mode == RenderMode::Path) d = allMaterialFeatureDefines();
+  std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_).defines();  // shader_features.cpp
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES and CAUSTICA_VERTEX_COLORS must not make a scene without
   // texcoords or colours read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
-  if (hasAlpha()) d.push_back("CAUSTICA_TRANSPARENT");  // coverage.glsl
-  if (settings_.mode != RenderMode::Path) return d;  // Whitted: materials only; raster: no compute variant
-  if (settings_.integrator == Integrator::Mis && (!gpuScene_.emitters.empty() || gpuScene_.environment.width > 0)) {
-    d.push_back("CAUSTICA_MIS");
-    if (!gpuScene_.casters.empty() && settings_.casterProbability > 0.0f) d.push_back("CAUSTICA_CASTERS");
-    // No emissive triangles (mis for the environment alone): the emitter estimate and the emitter-hit
-    // pdf are left out rather than run masked on every bounce (llvmpipe runs every branch; vertex.glsl).
-    if (gpuScene_.emitters.empty() && !settings_.allFeatures) d.push_back("CAUSTICA_NO_EMITTERS");
-  }
-  if (gpuScene_.features.dispersion && settings_.dispersion == DispersionMode::Spectral) d.push_back("CAUSTICA_SPECTRAL");
   return d;
 }
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
-  const char* entry = settings_.mode == RenderMode::Whitted ? "whitted.comp" : "pathtrace.comp";
+  const char* entry = renderModeSpec(settings_.mode).entryShader;
+  if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
   std::string key = std::string(entry) + ":";
   for (const auto& d : defines) key += d + " ";
   auto it = programs_.find(key);
@@ -235,6 +252,9 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   settings.validate();
   SettingsChange change = compareSettings(settings_, settings);
   if (!change.restart) return change;
+  // Another variant whenever a row of the feature table turns on or off, whichever field its settings
+  // test reads.
+  change.shader = change.shader || !(variantFeatures(sceneFeatures_, settings_) == variantFeatures(sceneFeatures_, settings));
   if (change.resize) checkImageSize(limits_, settings.width, settings.height);
   const RenderSettings previous = settings_;
   settings_ = settings;
@@ -300,9 +320,9 @@ void Renderer::renderRows(int y0, int y1, int spp) {
   y0 = std::max(0, y0);
   y1 = std::min(settings_.height, y1);
   if (y1 <= y0 || spp <= 0) return;
-  if (settings_.mode == RenderMode::Raster) {
-    // One deterministic frame drawn straight into the accumulation image (alpha = 1 sample), once
-    // per restart: later passes would only draw the same frame again.
+  if (!renderModeSpec(settings_.mode).entryShader) {
+    // The raster pipeline: one deterministic frame drawn straight into the accumulation image (alpha
+    // = 1 sample), once per restart (SampleRule::OneFrame): later passes would only draw it again.
     if (spp_ == 0 && y0 == 0) {
       prepareMode();
       pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
@@ -315,7 +335,7 @@ void Renderer::renderRows(int y0, int y1, int spp) {
 }
 
 void Renderer::renderPass(int spp) {
-  if (tileListActive_ && settings_.mode != RenderMode::Raster) {  // raster: one frame, no samples to spread
+  if (tileListActive_ && renderModeSpec(settings_.mode).samples != SampleRule::OneFrame) {  // one frame: no samples to spread
     if (liveTiles_ > 0 && spp > 0) dispatchSamples(spp, 0, settings_.height, true);
   } else {
     renderRows(0, settings_.height, spp);
@@ -366,11 +386,10 @@ constexpr int kMaxPassThroughs = 256;          // pathtrace.comp's kMaxPassThrou
 }  // namespace
 
 int Renderer::samplesPerDispatch() const {
-  if (settings_.mode != RenderMode::Path) return 1;  // whitted.comp traces one sample per dispatch
+  if (renderModeSpec(settings_.mode).samples != SampleRule::Regeneration) return 1;
   const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
   int perSample = settings_.maxDepth;
-  const std::vector<std::string> defines = shaderDefines();
-  if (std::find(defines.begin(), defines.end(), "CAUSTICA_OPACITY") != defines.end()) perSample += kMaxPassThroughs;
+  if (variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
   return std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
 }
 
@@ -433,7 +452,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
       sinceRead = 0;
     }
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
-    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, gpuScene_.emitters.size(), std::uint32_t(k));
+    fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), std::uint32_t(k));
     frameUbo_.update(0, sizeof fp, &fp);
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);

@@ -19,6 +19,7 @@
 #include "scene/scene.h"
 #include "gpu/render_settings.h"
 #include "gpu/scene_buffers.h"
+#include "gpu/shader_features.h"
 #include "gpu/shader_library.h"
 #include "image/error_estimate.h"
 #include "image/tonemap.h"
@@ -91,10 +92,10 @@ class Renderer {
   ErrorEstimate errorEstimate(int tileSize = CAUSTICA_WORKGROUP_X) const;
 
   int samplesPerPixel() const { return spp_; }
-  // Samples per pixel one path-tracing dispatch traces (pathtrace.comp's flat bounce loop, path
-  // regeneration): settings().samplesPerDispatch or the default, lowered so that K * (depth cap +
-  // alpha pass-throughs) <= kRegenBounceBudget; 1 in the Whitted and raster modes. A render loop
-  // should ask for passes of at least this many samples, or the dispatches trace fewer.
+  // Samples per pixel one dispatch traces: in modes of SampleRule::Regeneration (pathtrace.comp's flat
+  // bounce loop) settings().samplesPerDispatch or the default, lowered so that K * (depth cap + alpha
+  // pass-throughs) <= kRegenBounceBudget; else 1. A render loop should ask for passes of at least
+  // this many samples, or the dispatches trace fewer.
   int samplesPerDispatch() const;
   // Reads back both accumulation images and the sample counters (for checkpoints).
   AccumulationState saveAccumulation() const;
@@ -102,9 +103,9 @@ class Renderer {
   // renders exactly the samples an uninterrupted render would. Throws Error unless its size matches.
   void restoreAccumulation(const AccumulationState& state);
   Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
-  // --background transparent in a mode that tracks coverage (path, Whitted; not raster): image() has
-  // alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
-  bool hasAlpha() const { return transparent_ && settings_.mode != RenderMode::Raster; }
+  // --background transparent in a mode that tracks coverage (the CAUSTICA_TRANSPARENT row): image()
+  // has alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
+  bool hasAlpha() const { return variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_TRANSPARENT"); }
   // Tone-maps the accumulation into the rgba8 display texture (viewer).
   const GlTexture& updateDisplay(const ToneMapSettings& tone);
   const RenderStats& stats() const { return stats_; }
@@ -117,7 +118,10 @@ class Renderer {
   // The scene's storage blocks: bytes by array (measured before the host copies were freed) and split.
   const GpuSceneBytes& gpuBytes() const { return gpuBytes_; }
   const SceneBufferLayout& bufferLayout() const { return bufferLayout_; }
-  std::vector<std::string> shaderDefines() const;  // the variant the current settings need
+  // The shader-feature rows the scene needs (detectFeatures), and the defines of the variant the
+  // current settings need: variantFeatures' rows, then the storage layout's (split blocks, instancing).
+  const FeatureSet& sceneFeatures() const { return sceneFeatures_; }
+  std::vector<std::string> shaderDefines() const;
   // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
 
@@ -128,6 +132,13 @@ class Renderer {
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
+  // The constructor's steps, in order.
+  void checkLimits();                      // the GL context's limits and the settings
+  std::vector<gpu::BvhWideNode> buildScene(const Scene& scene);  // BVH and GpuScene; flat: the 4-wide nodes
+  void planBuffers(const Scene& scene);    // binary nodes cut to the root (flat), the storage blocks' plan
+  void uploadScene(const Scene& scene, std::vector<gpu::BvhWideNode> wideNodes);  // buffers and textures
+  void createUniformBuffers();             // frame, casters, punctual lights
+  void uploadLights(const Scene& scene, const Bounds& sceneBounds);  // point lights, environment
 
   const ShaderLibrary& library_;
   RenderSettings settings_;
@@ -135,6 +146,7 @@ class Renderer {
   Bvh bvh_;
   double bvhSeconds_ = 0.0;
   GpuScene gpuScene_;  // nodes, triGeom and triShade are freed once uploaded (only the GPU holds them)
+  FeatureSet sceneFeatures_;
   LoadTimes load_;
   std::chrono::steady_clock::time_point created_;
   GpuSceneBytes gpuBytes_;

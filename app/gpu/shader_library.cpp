@@ -79,23 +79,6 @@ struct Expander {
 
 }  // namespace
 
-const std::vector<std::string>& shaderFeatureNames() {
-  static const std::vector<std::string> names = {
-      "CAUSTICA_MIRROR",      // a material with metallic > 0
-      "CAUSTICA_GLASS",       // a material with transmission > 0
-      "CAUSTICA_VOLUME",      // Beer–Lambert absorption inside glass
-      "CAUSTICA_DISPERSION",  // wavelength-dependent index of refraction
-      "CAUSTICA_TEXTURES",    // base-colour or emissive textures
-      "CAUSTICA_OPACITY",     // base-colour alpha < 1
-      "CAUSTICA_MIS",         // integrator: next-event estimation with MIS (else naive)
-      "CAUSTICA_CASTERS",     // mis: diffuse bounces also aim at glass and mirror objects
-      "CAUSTICA_SPECTRAL",    // dispersion by hero wavelengths (else one RGB channel per path)
-      "CAUSTICA_GGX",         // GGX lobes: rough metal, rough glass, specular layer over diffuse
-      "CAUSTICA_ENV",         // an environment light or a background colour (environment.glsl)
-  };
-  return names;
-}
-
 ShaderLibrary::ShaderLibrary(std::string diskDir) : diskDir_(std::move(diskDir)) {}
 
 std::string ShaderLibrary::read(const std::string& path) const {

@@ -22,9 +22,6 @@ struct ExpandedShader {
   std::string mapLog(const std::string& log) const;
 };
 
-// Every feature define the shaders know. A scene gets only those it needs.
-const std::vector<std::string>& shaderFeatureNames();
-
 class ShaderLibrary {
  public:
   // Empty `diskDir`: the embedded sources; otherwise files are read from that folder (for editing).

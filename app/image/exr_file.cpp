@@ -55,28 +55,28 @@ std::pair<std::string, std::string> splitChannel(const std::string& full) {
   return {full.substr(0, dot), full.substr(dot + 1)};
 }
 
-bool hasChannel(const ExrLayer& l, const char* name) {
+bool hasChannel(const ImageLayer& l, const char* name) {
   return std::find(l.channels.begin(), l.channels.end(), name) != l.channels.end();
 }
 
 // A luminance/chroma image (Y with RY, BY): OpenEXR's RGBA interface converts it to RGB (half).
-std::vector<ExrLayer> readLuminanceChroma(const std::string& path, const Imath::Box2i& display,
+std::vector<ImageLayer> readLuminanceChroma(const std::string& path, const Imath::Box2i& display,
                                           const Imath::Box2i& data, bool alpha) {
   Imf::RgbaInputFile file(path.c_str());
   const std::int64_t w = boxWidth(data), h = boxHeight(data);
   std::vector<Imf::Rgba> pixels(std::size_t(w * h));
   file.setFrameBuffer(&pixels[0] - data.min.x - data.min.y * w, 1, std::size_t(w));
   file.readPixels(data.min.y, data.max.y);
-  ExrLayer out;
+  ImageLayer out;
   out.channels = {"R", "G", "B"};
   if (alpha) out.channels.push_back("A");
   const std::int64_t dw = boxWidth(display), dh = boxHeight(display);
   const std::size_t n = out.channels.size();
-  out.values.assign(std::size_t(dw * dh) * n, 0.0f);
+  out.data.assign(std::size_t(dw * dh) * n, 0.0f);
   for (std::int64_t y = std::max(data.min.y, display.min.y); y <= std::min(data.max.y, display.max.y); ++y)
     for (std::int64_t x = std::max(data.min.x, display.min.x); x <= std::min(data.max.x, display.max.x); ++x) {
       const Imf::Rgba& p = pixels[std::size_t((y - data.min.y) * w + (x - data.min.x))];
-      float* o = &out.values[std::size_t((y - display.min.y) * dw + (x - display.min.x)) * n];
+      float* o = &out.data[std::size_t((y - display.min.y) * dw + (x - display.min.x)) * n];
       o[0] = p.r;
       o[1] = p.g;
       o[2] = p.b;
@@ -87,7 +87,7 @@ std::vector<ExrLayer> readLuminanceChroma(const std::string& path, const Imath::
 
 }  // namespace
 
-void writeExrLayers(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers) {
+void writeExrLayers(const std::string& path, int width, int height, const std::vector<ImageLayer>& layers) {
   if (width < 1 || height < 1) throw Error(path + ": cannot write an empty EXR image");
   const std::size_t pixels = std::size_t(width) * std::size_t(height);
   // Half values converted up front: OpenEXR reads each slice in the type it is declared with.
@@ -96,19 +96,19 @@ void writeExrLayers(const std::string& path, int width, int height, const std::v
   header.compression() = Imf::ZIP_COMPRESSION;
   Imf::FrameBuffer frame;
   for (std::size_t l = 0; l < layers.size(); ++l) {
-    const ExrLayer& layer = layers[l];
+    const ImageLayer& layer = layers[l];
     const std::size_t n = layer.channels.size();
-    if (n == 0 || layer.values.size() != pixels * n)
-      throw Error("internal: " + path + ": EXR layer '" + layer.name + "' holds " + std::to_string(layer.values.size()) +
+    if (n == 0 || layer.data.size() != pixels * n)
+      throw Error("internal: " + path + ": EXR layer '" + layer.name + "' holds " + std::to_string(layer.data.size()) +
                   " values for " + std::to_string(n) + " channels of " + std::to_string(pixels) + " pixels");
     const Imf::PixelType type = layer.half ? Imf::HALF : Imf::FLOAT;
-    if (layer.half) halves[l].assign(layer.values.begin(), layer.values.end());
+    if (layer.half) halves[l].assign(layer.data.begin(), layer.data.end());
     for (std::size_t c = 0; c < n; ++c) {
       const std::string name = layer.name.empty() ? layer.channels[c] : layer.name + "." + layer.channels[c];
       if (header.channels().findChannel(name)) throw Error("internal: " + path + ": EXR channel " + name + " twice");
       header.channels().insert(name, Imf::Channel(type));
       char* base = layer.half ? reinterpret_cast<char*>(halves[l].data() + c)
-                              : reinterpret_cast<char*>(const_cast<float*>(layer.values.data() + c));
+                              : reinterpret_cast<char*>(const_cast<float*>(layer.data.data() + c));
       const std::size_t size = layer.half ? sizeof(Imath::half) : sizeof(float);
       frame.insert(name, Imf::Slice(type, base, size * n, size * n * std::size_t(width)));
     }
@@ -123,7 +123,7 @@ void writeExrLayers(const std::string& path, int width, int height, const std::v
   }
 }
 
-std::vector<ExrLayer> readExrLayers(const std::string& path, int& width, int& height) {
+std::vector<ImageLayer> readExrLayers(const std::string& path, int& width, int& height) {
   try {
     startThreads();
     Imf::MultiPartInputFile file(path.c_str());
@@ -142,7 +142,7 @@ std::vector<ExrLayer> readExrLayers(const std::string& path, int& width, int& he
       for (auto it = file.header(p).channels().begin(); it != file.header(p).channels().end(); ++it) ++seen[it.name()];
     const bool prefixParts = std::any_of(seen.begin(), seen.end(), [](const auto& s) { return s.second > 1; });
 
-    std::vector<ExrLayer> layers;
+    std::vector<ImageLayer> layers;
     std::int64_t values = 0;
     for (int p = 0; p < parts; ++p) {
       const Imf::Header& header = file.header(p);
@@ -156,7 +156,7 @@ std::vector<ExrLayer> readExrLayers(const std::string& path, int& width, int& he
       if (luminanceChroma && parts == 1) return readLuminanceChroma(path, display, data, channels.findChannel("A"));
       const std::string partName = prefixParts && header.hasName() ? header.name() : "";
       // Group the full-resolution channels by layer, in the file's (alphabetical) order.
-      std::map<std::string, ExrLayer> byName;
+      std::map<std::string, ImageLayer> byName;
       std::map<std::string, std::vector<std::string>> fileNames;  // layer -> its channels' names in the file
       std::vector<std::string> order;
       for (auto it = channels.begin(); it != channels.end(); ++it) {
@@ -164,13 +164,13 @@ std::vector<ExrLayer> readExrLayers(const std::string& path, int& width, int& he
         auto [layer, channel] = splitChannel(it.name());
         if (!partName.empty()) layer = layer.empty() ? partName : partName + "." + layer;
         if (!byName.count(layer)) order.push_back(layer);
-        ExrLayer& l = byName[layer];
+        ImageLayer& l = byName[layer];
         l.name = layer;
         l.channels.push_back(channel);
         fileNames[layer].push_back(it.name());
       }
       for (const std::string& name : order) {
-        ExrLayer& l = byName[name];
+        ImageLayer& l = byName[name];
         const std::size_t n = l.channels.size();
         values += std::int64_t(n) * (w * h + dw * dh);
         if (values > kMaxValues) readFailed(path, "its channels are too large to read together");
@@ -183,12 +183,12 @@ std::vector<ExrLayer> readExrLayers(const std::string& path, int& width, int& he
         part.setFrameBuffer(frame);
         part.readPixels(data.min.y, data.max.y);
         // Into the display window.
-        l.values.assign(std::size_t(dw * dh) * n, 0.0f);
+        l.data.assign(std::size_t(dw * dh) * n, 0.0f);
         for (std::int64_t y = std::max(data.min.y, display.min.y); y <= std::min(data.max.y, display.max.y); ++y) {
           const std::int64_t x0 = std::max(data.min.x, display.min.x), x1 = std::min(data.max.x, display.max.x);
           if (x0 > x1) break;
           std::copy_n(&buffer[std::size_t((y - data.min.y) * w + (x0 - data.min.x)) * n], std::size_t(x1 - x0 + 1) * n,
-                      &l.values[std::size_t((y - display.min.y) * dw + (x0 - display.min.x)) * n]);
+                      &l.data[std::size_t((y - display.min.y) * dw + (x0 - display.min.x)) * n]);
         }
         layers.push_back(std::move(l));
       }
@@ -205,13 +205,13 @@ std::vector<ExrLayer> readExrLayers(const std::string& path, int& width, int& he
   }
 }
 
-const ExrLayer* colorLayer(const std::vector<ExrLayer>& layers) {
-  const auto rgb = [](const ExrLayer& l) { return hasChannel(l, "R") && hasChannel(l, "G") && hasChannel(l, "B"); };
-  for (const ExrLayer& l : layers)
+const ImageLayer* colorLayer(const std::vector<ImageLayer>& layers) {
+  const auto rgb = [](const ImageLayer& l) { return hasChannel(l, "R") && hasChannel(l, "G") && hasChannel(l, "B"); };
+  for (const ImageLayer& l : layers)
     if (l.name.empty() && rgb(l)) return &l;
-  for (const ExrLayer& l : layers)
+  for (const ImageLayer& l : layers)
     if (rgb(l)) return &l;
-  for (const ExrLayer& l : layers)
+  for (const ImageLayer& l : layers)
     if (hasChannel(l, "Y")) return &l;
   return nullptr;
 }

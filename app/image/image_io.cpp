@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <stb_image_write.h>
@@ -49,17 +50,20 @@ std::vector<float> interleaveAlpha(const Image& img) {
   return rgba;
 }
 
-void writeExr(const std::string& path, const Image& img) {
-  // Linear float RGB (+ A: OpenEXR's convention is colour premultiplied by alpha, which rgb already is).
-  ExrLayer main;
+// The image's own layer: linear float R, G, B (+ A: OpenEXR's convention is colour premultiplied by
+// alpha, which rgb already is).
+ImageLayer mainLayer(const Image& img) {
+  ImageLayer main;
   main.channels = {"R", "G", "B"};
-  main.values = img.rgb;
+  main.data = img.rgb;
   if (!img.alpha.empty()) {
     main.channels.push_back("A");
-    main.values = interleaveAlpha(img);
+    main.data = interleaveAlpha(img);
   }
-  writeExrLayers(path, img.width, img.height, {main});
+  return main;
 }
+
+void writeExr(const std::string& path, const Image& img) { writeExrLayers(path, img.width, img.height, {mainLayer(img)}); }
 
 void writePfm(const std::string& path, const Image& img) {
   std::ofstream f(path, std::ios::binary);
@@ -73,11 +77,11 @@ void writePfm(const std::string& path, const Image& img) {
 
 Image readExr(const std::string& path) {
   int w = 0, h = 0;
-  const std::vector<ExrLayer> layers = readExrLayers(path, w, h);
-  const ExrLayer* layer = colorLayer(layers);
+  const std::vector<ImageLayer> layers = readExrLayers(path, w, h);
+  const ImageLayer* layer = colorLayer(layers);
   if (!layer) {
     std::string names;
-    for (const ExrLayer& l : layers)
+    for (const ImageLayer& l : layers)
       for (const std::string& c : l.channels) names += (names.empty() ? "" : ", ") + (l.name.empty() ? c : l.name + "." + c);
     throw Error(path + ": the EXR file has no R, G, B or Y channels (it has: " + (names.empty() ? "none" : names) + ")");
   }
@@ -93,8 +97,8 @@ Image readExr(const std::string& path) {
   Image img{w, h, std::vector<float>(pixels * 3)};
   if (a >= 0) img.alpha.resize(pixels);
   for (std::size_t i = 0; i < pixels; ++i) {
-    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer->values[i * n + std::size_t(rgb[c])];
-    if (a >= 0) img.alpha[i] = layer->values[i * n + std::size_t(a)];
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer->data[i * n + std::size_t(rgb[c])];
+    if (a >= 0) img.alpha[i] = layer->data[i * n + std::size_t(a)];
   }
   return img;
 }
@@ -118,6 +122,17 @@ Image readPfm(const std::string& path) {
 }
 
 }  // namespace
+
+void writeExrLayers(const std::string& path, const Image& image, const std::vector<ImageLayer>& layers) {
+  std::vector<ImageLayer> all = {mainLayer(image)};
+  std::set<std::string> names;
+  for (const ImageLayer& l : layers) {
+    if (l.name.empty() || !names.insert(l.name).second || l.channels.empty())
+      throw Error(path + ": internal: EXR layer '" + l.name + "' is unnamed, repeated or has no channels");
+    all.push_back(l);
+  }
+  writeExrLayers(path, image.width, image.height, all);
+}
 
 std::vector<float> unpremultiplied(const Image& image) {
   std::vector<float> rgb = image.rgb;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "image/exr_file.h"
 #include "image/tonemap.h"
 
 namespace caustica {
@@ -30,6 +31,11 @@ void writeImage(const std::string& path, const Image& image, const ToneMapSettin
 // Reads a linear .exr (its colour layer, exr_file.h: R, G, B or Y, and A when present, any compression,
 // half or float) or .pfm file.
 Image readImage(const std::string& path);
+// Writes `image` (as writeImage writes an EXR: R, G, B, and A with alpha) and every layer in `layers`
+// (named, e.g. "albedo" with channels R, G, B: ImageLayer in exr_file.h) into one EXR file through
+// OpenEXR. Throws Error naming the file on failure, or when a layer is unnamed, repeated or does not
+// match the image size. (readExrLayers in exr_file.h reads them back.)
+void writeExrLayers(const std::string& path, const Image& image, const std::vector<ImageLayer>& layers);
 // Writes 8-bit RGB bytes (w*h*3), or RGBA bytes (w*h*4) with channels = 4, as PNG.
 void writePng(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb, int channels = 3);
 // Straight (unpremultiplied) colour of a premultiplied pixel: rgb / alpha, 0 where alpha is 0.

@@ -1,5 +1,5 @@
 // intersect.glsl — watertight ray–triangle test and ray–box slab test (world space; t in units of |dir|).
-// Twins of intersectTriangle() and intersectAabb() in app/accel/bvh.cpp; keep the two in step.
+// Twins of intersectTriangle() in app/accel/intersect.cpp and intersectAabb() in app/accel/ray_box.h; keep them in step.
 // Needs gammaBound() from spawn.glsl.
 
 // Cyclic permutation that moves axis kz to z (keeps handedness; both faces are accepted anyway).

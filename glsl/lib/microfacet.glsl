@@ -11,6 +11,13 @@ const uint kLobeConductor = 3u;   // rough metal: GGX, Schlick Fresnel with F0 =
 const uint kLobePlastic = 4u;     // GGX dielectric specular over Lambertian
 const uint kLobeRoughGlass = 5u;  // rough dielectric: GGX reflection and refraction
 
+// The glossy lobes (from kLobeConductor up: non-delta and not Lambertian) are compiled in when a
+// feature that makes one is (the shader-feature table): the bounce loop's glossy branches
+// (path_scatter.glsl) test this, so a new glossy lobe adds its define here, not there.
+#if defined(CAUSTICA_GGX)
+#define CAUSTICA_GLOSSY_LOBES
+#endif
+
 const float kDeltaAlpha = 1.0e-3;       // below this GGX alpha a metal or glass lobe is the delta lobe
 const float kMinPlasticAlpha = 1.0e-3;  // the plastic lobe's alpha is at least this
 

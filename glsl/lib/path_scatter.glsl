@@ -58,8 +58,8 @@ struct BounceLobe {
 };
 
 bool isDiffuseLobe(BounceLobe l) { return l.lobe == kLobeDiffuse; }
-bool isGlossyLobe(BounceLobe l) {  // the GGX lobes: rough metal, plastic, rough glass (microfacet.glsl)
-#ifdef CAUSTICA_GGX
+bool isGlossyLobe(BounceLobe l) {  // the glossy lobes: rough metal, plastic, rough glass (microfacet.glsl)
+#ifdef CAUSTICA_GLOSSY_LOBES
   return l.lobe >= kLobeConductor;
 #else
   return false;
@@ -105,11 +105,11 @@ vec3 sampleCasterMixture(inout PathState s, Surface sf) {
 #endif
 
 // The vertex as every light estimate sees it (vertex.glsl), built once for the non-delta lobes: the
-// Lambertian lobe (roughness and eta 1) or the GGX lobe. Without GGX the lobe here is the Lambertian
-// one: said as a constant, so that the GGX code of vertexEval / vertexPdf (bsdfEvalPdf) folds away
-// instead of running masked on every bounce.
+// Lambertian lobe (roughness and eta 1) or a glossy lobe. Without glossy lobes (CAUSTICA_GLOSSY_LOBES,
+// microfacet.glsl) the lobe here is the Lambertian one: said as a constant, so that the GGX code of
+// vertexEval / vertexPdf (bsdfEvalPdf) folds away instead of running masked on every bounce.
 Vertex lobeVertex(PathState s, Surface sf, BounceLobe l) {
-#ifdef CAUSTICA_GGX
+#ifdef CAUSTICA_GLOSSY_LOBES
   uint vertexLobe = l.lobe;
 #else
   const uint vertexLobe = kLobeDiffuse;
@@ -139,7 +139,7 @@ bool scatterNonDelta(inout PathState s, Surface sf, Vertex v, BounceLobe l, inou
 #endif
     s.prevDelta = false;
   }
-#ifdef CAUSTICA_GGX
+#ifdef CAUSTICA_GLOSSY_LOBES
   else {
     BsdfSample bs;
     float uPart = rand01(s.rng);

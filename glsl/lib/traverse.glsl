@@ -1,7 +1,7 @@
 // traverse.glsl — closest-hit and any-hit BVH traversal over the 112-byte 4-wide BVH nodes and the
 // triangle positions, both read through buffer textures (bindings.glsl). Twin of traceClosest()/
 // traceOccluded() over gpu::BvhWideNode in app/accel/bvh_wide.cpp; keep the two in step. Also holds the
-// binary node visit (bvhVisitNode, twin of app/accel/bvh.cpp) that traverse_instanced.glsl uses:
+// binary node visit (bvhVisitNode, twin of app/accel/ray_box.h) that traverse_instanced.glsl uses:
 // instanced scenes (CAUSTICA_INSTANCED) trace through the binary two-level BVH instead of the wide nodes.
 // Include bindings.glsl, spawn.glsl and intersect.glsl first.
 //

@@ -192,14 +192,6 @@ struct Material {
                       // w: alpha cutoff (both float bits)
 };
 
-// One alias-table slot over emissive triangles (16 bytes).
-struct Emitter {
-  uint tri;         // triangle index (in TriGeom order)
-  float prob;       // probability of choosing this slot's own triangle when the slot is picked
-  uint alias;       // slot whose triangle is taken otherwise
-  float pdfSelect;  // probability that this slot's triangle is selected overall (power / total power)
-};
-
 // A texture inside the texel SSBO (48 bytes, stored as kTexInfoWords uints at the head of that SSBO).
 // Several may share texels (KHR_texture_transform).
 struct TexInfo {
@@ -224,7 +216,6 @@ struct Counters {
 // One node of the light tree over the emissive triangles (64 bytes; app/accel/light_tree.h,
 // glsl/lib/light_tree.glsl): a binary BVH whose nodes bound the position, power and emission
 // directions of their triangles (Conty Estevez & Kulla 2018). Node 0 is the root; one triangle per leaf.
-// (Emitter above is the former alias-table slot, unused since the light tree.)
 struct LightNode {
   vec4 boundsMin;  // xyz: world-space AABB minimum; w: power (sum of luminance(emission) * area * sides)
   vec4 boundsMax;  // xyz: world-space AABB maximum; w: cos(theta_o), the normal cone's half angle
@@ -318,7 +309,6 @@ static_assert(sizeof(InstanceRecord) == 64, "InstanceRecord must be 64 bytes (4 
 static_assert(sizeof(InstanceShade) == 64, "InstanceShade must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
 static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
-static_assert(sizeof(Emitter) == 16, "Emitter must be 16 bytes (std430)");
 static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");

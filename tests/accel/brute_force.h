@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/intersect.h"
 
 namespace caustica::test {
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "brute_force.h"
 #include "scene/obj_mesh.h"
 #include "util/error.h"

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "brute_force.h"
 #include "accel/bvh_wide.h"
 #include "scene/obj_mesh.h"

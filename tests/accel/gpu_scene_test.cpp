@@ -1,6 +1,6 @@
-// gpu_scene_test.cpp — packing for the GPU: alias-table frequencies, emitter weights matching the
-// shader's lightPdfArea(), material conversion and feature detection, the TriShade words from the
-// scene model's compact triangles.
+// gpu_scene_test.cpp — packing for the GPU: the emitters' count and light-tree powers, material
+// conversion, used materials, the TriShade words from the scene model's compact triangles. (Feature
+// detection: tests/gpu/shader_features_test.cpp.)
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -29,39 +29,7 @@ Triangle quadTri(float size, float y, std::uint32_t material, bool second) {
 }
 }  // namespace
 
-TEST_CASE("alias table picks each item with probability proportional to its weight") {
-  std::vector<double> w = {1.0, 0.0, 7.5, 0.25, 3.0, 12.0, 0.01};
-  std::vector<std::uint32_t> items = {10, 11, 12, 13, 14, 15, 16};
-  auto table = buildAliasTable(w, items);
-  REQUIRE(table.size() == w.size());
-  double total = 0;
-  for (double x : w) total += x;
-  // Exact probabilities implied by the table: P(item) = sum over slots of (1/n)(prob or 1-prob).
-  std::vector<double> p(w.size(), 0.0);
-  for (size_t s = 0; s < table.size(); ++s) {
-    p[table[s].tri - 10] += table[s].prob / table.size();
-    p[table[table[s].alias].tri - 10] += (1.0 - table[s].prob) / table.size();
-  }
-  for (size_t i = 0; i < w.size(); ++i) {
-    CHECK(p[i] == doctest::Approx(w[i] / total).epsilon(1e-5));
-    CHECK(table[i].pdfSelect == doctest::Approx(w[i] / total).epsilon(1e-6));
-  }
-  // And sampling it the way lights.glsl does agrees (chi-square-like bound on counts).
-  RngState rng = rngSeed(12345, 0, 0);
-  std::vector<int> counts(w.size(), 0);
-  const int n = 200000;
-  for (int k = 0; k < n; ++k) {
-    unsigned slot = std::min(static_cast<unsigned>(rand01(rng) * table.size()), static_cast<unsigned>(table.size() - 1));
-    std::uint32_t tri = rand01(rng) < table[slot].prob ? table[slot].tri : table[table[slot].alias].tri;
-    counts[tri - 10]++;
-  }
-  for (size_t i = 0; i < w.size(); ++i) {
-    double expected = n * w[i] / total;
-    CHECK(std::abs(counts[i] - expected) <= 5.0 * std::sqrt(expected) + 1.0);
-  }
-}
-
-TEST_CASE("emitters: one alias slot per emissive triangle, weights luminance x area x sides") {
+TEST_CASE("emitters: one light-tree leaf per emissive triangle, power luminance x area x sides") {
   Scene s;
   Material white;
   white.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
@@ -74,22 +42,26 @@ TEST_CASE("emitters: one alias slot per emissive triangle, weights luminance x a
                  quadTri(0.25f, 1.5f, 2, false)};
   Bvh bvh = buildBvh(s.triangles);
   GpuScene g = packScene(s, bvh);
-  CHECK(g.emitters.size() == 3);
+  CHECK(g.emitterCount == 3);
   float lum = luminance(light.emission);
   double expected = lum * (0.5 * 0.5 * 4) + lum * (0.25 * 0.25 * 4 / 2) * 2;  // two halves of a 1x1 quad + double-sided half
   CHECK(g.totalEmitterWeight == doctest::Approx(expected).epsilon(1e-5));
   CHECK(g.totalPower == doctest::Approx(kPi * expected).epsilon(1e-5));
-  // The shader's per-area pdf lum*sides/total must equal pdfSelect/area for every slot.
-  for (const auto& e : g.emitters) {
-    const auto& t = g.triGeom[e.tri];
+  // Each leaf's power (what the shaders choose it by) is luminance x area x sides of its triangle.
+  std::size_t leaves = 0;
+  for (const gpu::LightNode& node : g.lightTree.nodes) {
+    if ((node.link.y & gpu::kLightNodeLeaf) == 0u) continue;
+    ++leaves;
+    const auto& t = g.triGeom[node.link.x];
     float area = 0.5f * glm::length(glm::cross(glm::vec3(t.v1 - t.v0), glm::vec3(t.v2 - t.v0)));
     std::uint32_t mi = glm::floatBitsToUint(t.v0.w);
     float sides = s.materials[mi].doubleSided ? 2.0f : 1.0f;
-    CHECK(e.pdfSelect / area == doctest::Approx(lum * sides / g.totalEmitterWeight).epsilon(1e-4));
+    CHECK(node.boundsMin.w / area == doctest::Approx(lum * sides).epsilon(1e-4));
   }
+  CHECK(leaves == g.emitterCount);
 }
 
-TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, flags, features") {
+TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, flags") {
   Scene s;
   Material glass;
   glass.transmission = 1.0f;
@@ -107,34 +79,31 @@ TEST_CASE("materials: absorption from attenuation, Abbe number from dispersion, 
   CHECK(m.absorption.w == doctest::Approx(40.0));  // V = 20 / dispersion
   CHECK((m.tex.z & gpu::kMatHasVolume) != 0u);
   CHECK((m.tex.z & gpu::kMatDispersive) != 0u);
-  CHECK(g.features.glass);
-  CHECK(g.features.volume);
-  CHECK(g.features.dispersion);
-  CHECK_FALSE(g.features.mirror);
-  CHECK_FALSE(g.features.textures);
-  CHECK(g.features.describe() == "glass volume dispersion");
 }
 
-TEST_CASE("a material no triangle uses does not switch features on") {
+TEST_CASE("a material no triangle uses is not used, and its textures add no texcoords to the TriShade words") {
   Scene s;
-  Material white, mirror;
-  mirror.metallic = 1.0f;
-  s.materials = {white, mirror};
+  Material white, textured;
+  textured.baseColorTexture = 0;
+  s.materials = {white, textured};
   s.triangles = {quadTri(1, 0, 0, false)};
-  CHECK_FALSE(sceneFeatures(s).mirror);
-  CHECK(sceneFeatures(s).defines().empty());
+  CHECK(usedMaterials(s) == std::vector<bool>{true, false});
+  CHECK(packScene(s, buildBvh(s.triangles)).triShadeStride == gpu::kTriShadeWords);
+  s.triangles.push_back(quadTri(1, 0, 1, true));
+  CHECK(usedMaterials(s) == std::vector<bool>{true, true});
+  CHECK(packScene(s, buildBvh(s.triangles)).triShadeStride == gpu::kTriShadeWordsTextured);
 }
 
-TEST_CASE("GGX materials: rough lobes switch CAUSTICA_GGX on; specular layer, data textures and shared texels are packed") {
+TEST_CASE("GGX materials: rough lobes (hasRoughLobe); specular layer, data textures and shared texels are packed") {
   Scene s;
   Material smoothMirror;
   smoothMirror.metallic = 1.0f;
   smoothMirror.roughness = 0.03f;  // alpha 9e-4 < kDeltaAlpha: still the delta mirror
   s.materials = {smoothMirror};
   s.triangles = {quadTri(1, 0, 0, false)};
-  CHECK_FALSE(packScene(s, buildBvh(s.triangles)).features.ggx);
+  CHECK_FALSE(hasRoughLobe(s.materials[0]));
   s.materials[0].roughness = 0.04f;  // alpha 1.6e-3: GGX
-  CHECK(packScene(s, buildBvh(s.triangles)).features.ggx);
+  CHECK(hasRoughLobe(s.materials[0]));
 
   Material plastic;
   plastic.specularF0 = glm::vec3(0.04f, 0.03f, 0.02f);
@@ -156,9 +125,8 @@ TEST_CASE("GGX materials: rough lobes switch CAUSTICA_GGX on; specular layer, da
   s.textures = {t, shared};
   s.materials = {plastic};
   GpuScene g = packScene(s, buildBvh(s.triangles));
-  CHECK(g.features.ggx);  // a diffuse base with a specular layer is GGX
-  CHECK(g.features.textures);
-  CHECK(g.features.opacity);  // texture alpha (MASK)
+  CHECK(hasRoughLobe(plastic));  // a diffuse base with a specular layer is GGX
+  CHECK(g.triShadeStride == gpu::kTriShadeWordsTextured);
   const gpu::Material& m = g.materials[0];
   CHECK(m.specular == glm::vec4(0.04f, 0.03f, 0.02f, 0.5f));
   CHECK(m.tex2.x == 1u);

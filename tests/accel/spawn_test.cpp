@@ -8,6 +8,7 @@
 #include <random>
 
 #include "accel/bvh.h"
+#include "accel/intersect.h"
 #include "accel/spawn.h"
 
 using namespace caustica;

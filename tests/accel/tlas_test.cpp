@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "accel/tlas.h"
 #include "scene/scene.h"
 #include "util/error.h"

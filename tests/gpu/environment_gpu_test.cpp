@@ -47,64 +47,10 @@ Environment patchMap(int w, int h, const std::vector<Patch>& patches, bool sky, 
   return e;
 }
 
-std::uint32_t addMaterial(Scene& s, glm::vec3 base, float transmission = 0.0f, float metallic = 0.0f) {
-  Material m;
-  m.baseColor = glm::vec4(base, 1.0f);
-  m.transmission = transmission;
-  m.metallic = metallic;
-  s.materials.push_back(m);
-  return static_cast<std::uint32_t>(s.materials.size() - 1);
-}
-
-// An axis-aligned box with flat normals, fronts outwards.
-void addBox(Scene& s, glm::vec3 lo, glm::vec3 hi, std::uint32_t mat) {
-  glm::vec3 p[8];
-  for (int i = 0; i < 8; ++i) p[i] = glm::vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
-  addQuad(s, p[0], p[4], p[6], p[2], mat);  // -x
-  addQuad(s, p[1], p[3], p[7], p[5], mat);  // +x
-  addQuad(s, p[0], p[1], p[5], p[4], mat);  // -y
-  addQuad(s, p[2], p[6], p[7], p[3], mat);  // +y
-  addQuad(s, p[0], p[2], p[3], p[1], mat);  // -z
-  addQuad(s, p[4], p[5], p[7], p[6], mat);  // +z
-}
-
-void finish(Scene& s) {
-  for (const Triangle& t : s.triangles)
-    for (const auto& q : t.p) s.bounds.grow(q);
-}
-
-Camera lookingDownMinusZ(glm::vec3 pos, float yfov = 0.7f) {
-  Camera c;
-  c.position = pos;
-  c.forward = glm::vec3(0, 0, -1);
-  c.up = glm::vec3(0, 1, 0);
-  c.yfov = yfov;
-  return c;
-}
-
-RenderSettings settingsFor(int w, int h, Integrator integ, std::uint32_t seed = 1) {
-  RenderSettings s;
-  s.width = w;
-  s.height = h;
-  s.integrator = integ;
-  s.seed = seed;
-  return s;
-}
-
-template <class To, class From>
-To bitsOf(const From& v) {
-  static_assert(sizeof(To) == sizeof(From));
-  To out;
-  std::memcpy(&out, &v, sizeof out);
-  return out;
-}
-
 }  // namespace
 
 TEST_CASE("environment twins: GLSL sampleEnvironment, environmentPdf, environmentRadiance and the uv maps match C++") {
-  ExpandedShader src = ShaderLibrary().expand("tests/environment_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); },
-                                             "tests/environment_test.comp");
+  GlProgram prog = compileTestShader("tests/environment_test.comp");
   GpuScene g;
   g.environment = buildEnvironmentDistribution(
       patchMap(64, 32, {{40, 9, glm::vec3(400.0f)}, {10, 20, glm::vec3(5.0f, 0.0f, 0.0f)}}, true, 30.0f));
@@ -124,8 +70,8 @@ TEST_CASE("environment twins: GLSL sampleEnvironment, environmentPdf, environmen
     if (i < 16) us[i] = glm::vec2(i < 8 ? 0.0f : 0.99999994f, (i % 8) / 8.0f);  // edges of the unit square
     float z = 2.0f * U(gen) - 1.0f, phi = 6.2831853f * U(gen), r = std::sqrt(std::max(0.0f, 1.0f - z * z));
     ds[i] = glm::vec3(r * std::cos(phi), z, r * std::sin(phi));
-    in[i * 2] = glm::uvec4(bitsOf<glm::uvec2>(us[i]), 0u, 0u);
-    in[i * 2 + 1] = glm::uvec4(bitsOf<glm::uvec3>(ds[i]), 0u);
+    in[i * 2] = glm::uvec4(sameBits<glm::uvec2>(us[i]), 0u, 0u);
+    in[i * 2 + 1] = glm::uvec4(sameBits<glm::uvec3>(ds[i]), 0u);
   }
   GlBuffer inBuf = GlBuffer::fromVector(in);
   GlBuffer outBuf = GlBuffer::create(sizeof(glm::uvec4) * 4 * n, nullptr);
@@ -152,18 +98,18 @@ TEST_CASE("environment twins: GLSL sampleEnvironment, environmentPdf, environmen
     glm::vec3 dir, le;
     float pdf;
     bool ok = sampleEnvironment(d, us[i], dir, le, pdf);
-    glm::vec3 gDir = bitsOf<glm::vec3>(glm::uvec3(o[0]));
-    glm::vec4 gLePdf = bitsOf<glm::vec4>(o[1]);
+    glm::vec3 gDir = sameBits<glm::vec3>(glm::uvec3(o[0]));
+    glm::vec4 gLePdf = sameBits<glm::vec4>(o[1]);
     if (ok != (o[0].w != 0u) || glm::vec3(gLePdf) != le) ++sampleMismatch;
     if (ok) {
       maxDir = std::max<double>(maxDir, glm::length(gDir - dir));
       maxPdf = std::max<double>(maxPdf, std::abs(gLePdf.w - pdf) / pdf);
     }
-    glm::vec4 gLook = bitsOf<glm::vec4>(o[2]);
+    glm::vec4 gLook = sameBits<glm::vec4>(o[2]);
     float p = environmentPdf(d, ds[i]);
     if (glm::vec3(gLook) != environmentRadiance(d, ds[i])) ++lookupMismatch;
     else if (p > 0.0f) maxPdf = std::max<double>(maxPdf, std::abs(gLook.w - p) / p);
-    glm::vec4 gUv = bitsOf<glm::vec4>(o[3]);
+    glm::vec4 gUv = sameBits<glm::vec4>(o[3]);
     glm::vec2 uv = envDirectionToUv(ds[i], d.cosRotation, d.sinRotation);
     maxUv = std::max<double>(maxUv, std::max(std::abs(gUv.x - uv.x), std::abs(gUv.y - uv.y)));
     glm::vec3 back = envUvToDirection(us[i], d.cosRotation, d.sinRotation);
@@ -182,17 +128,17 @@ TEST_CASE("environment twins: GLSL sampleEnvironment, environmentPdf, environmen
 TEST_CASE("environment furnace: a diffuse box of albedo 0.5 under a uniform sky of radiance 1 is 0.5, the sky 1") {
   Scene s;
   s.path = "furnace";
-  std::uint32_t mat = addMaterial(s, glm::vec3(0.5f));
+  std::uint32_t mat = addMaterial(s, diffuseMaterial(0.5f));
   addBox(s, glm::vec3(-0.6f, -0.5f, -0.4f), glm::vec3(0.5f, 0.6f, 0.4f), mat);
-  finish(s);
+  finishBounds(s);
   s.environment = uniformEnvironment(glm::vec3(1.0f));
-  Camera cam = lookingDownMinusZ(glm::vec3(0.8f, 0.9f, 3.0f), 0.6f);
+  Camera cam = cameraAt(glm::vec3(0.8f, 0.9f, 3.0f), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0), 0.6f);
   cam.forward = glm::normalize(glm::vec3(0.0f) - cam.position);
   cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
   const int w = 48, h = 48;
   // Naive: every sample of an object pixel is exactly 0.5 (its one bounce sees the sky, a convex
   // object never itself), of a background pixel exactly 1.
-  RenderResult naive = renderScene(s, cam, settingsFor(w, h, Integrator::Naive), 8);
+  RenderResult naive = renderScene(s, cam, smallSettings(w, h, Integrator::Naive), 8);
   std::vector<int> cls(static_cast<size_t>(w) * h, -1);  // 0: object, 1: sky, -1: silhouette
   int objects = 0, skies = 0;
   for (int y = 0; y < h; ++y)
@@ -228,7 +174,7 @@ TEST_CASE("environment furnace: a diffuse box of albedo 0.5 under a uniform sky 
   const int renders = 8;
   std::vector<double> means;
   for (std::uint32_t seed = 1; seed <= renders; ++seed) {
-    RenderResult mis = renderScene(s, cam, settingsFor(w, h, Integrator::Mis, seed), 16);
+    RenderResult mis = renderScene(s, cam, smallSettings(w, h, Integrator::Mis, seed), 16);
     CHECK(mis.stats.nonFinite == 0);
     bool hasEnv = false;
     for (const auto& def : mis.defines) hasEnv |= def == "CAUSTICA_ENV";
@@ -262,7 +208,7 @@ TEST_CASE("environment furnace: a diffuse box of albedo 0.5 under a uniform sky 
   // --background 0.25: camera rays that leave see the colour; the object is still lit by the sky.
   s.background.kind = Background::Kind::Color;
   s.background.color = glm::vec3(0.25f);
-  RenderResult bg = renderScene(s, cam, settingsFor(w, h, Integrator::Naive), 4);
+  RenderResult bg = renderScene(s, cam, smallSettings(w, h, Integrator::Naive), 4);
   int off = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -277,14 +223,14 @@ TEST_CASE("environment convention: a camera looking down -Z sees u = 0.25 in the
   // One tiny triangle behind the camera (the scene needs one); everything seen is the environment.
   Scene s;
   s.path = "convention";
-  std::uint32_t mat = addMaterial(s, glm::vec3(0.5f));
+  std::uint32_t mat = addMaterial(s, diffuseMaterial(0.5f));
   s.triangles.push_back(makeTriangle({0, 0, 50}, {0.1f, 0, 50}, {0, 0.1f, 50}, mat));
-  finish(s);
+  finishBounds(s);
   const int mw = 64, mh = 32;
   // White at u = 0.25 (texels 15-16), red at u = 18/64 (texels 17-18) right of it, green at u = 0.5 (+X).
   std::vector<Patch> patches = {{15, 15, glm::vec3(10, 10, 10)}, {17, 15, glm::vec3(10, 0, 0)}, {31, 15, glm::vec3(0, 10, 0)}};
   const int w = 64, h = 64;
-  Camera cam = lookingDownMinusZ(glm::vec3(0.0f), 0.7f);
+  Camera cam = cameraAt(glm::vec3(0.0f), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0), 0.7f);
   auto centroid = [&](const Image& img, int channelOnly, int& count) {
     glm::dvec2 sum(0.0);
     double wsum = 0.0;
@@ -310,7 +256,7 @@ TEST_CASE("environment convention: a camera looking down -Z sees u = 0.25 in the
   for (float rotation : {0.0f, 90.0f}) {
     CAPTURE(rotation);
     s.environment = patchMap(mw, mh, patches, false, rotation);
-    RenderResult r = renderScene(s, cam, settingsFor(w, h, Integrator::Mis), 4);
+    RenderResult r = renderScene(s, cam, smallSettings(w, h, Integrator::Mis), 4);
     int nRed = 0, nGreen = 0;
     glm::dvec2 red = centroid(r.image, 0, nRed), green = centroid(r.image, 1, nGreen);
     if (rotation == 0.0f) {
@@ -338,21 +284,17 @@ TEST_CASE("environment convention: a camera looking down -Z sees u = 0.25 in the
 TEST_CASE("environment: naive and mis agree under a small bright sun (floor, box, glass ball)") {
   Scene s;
   s.path = "sun";
-  std::uint32_t floorMat = addMaterial(s, glm::vec3(0.8f));
-  std::uint32_t boxMat = addMaterial(s, glm::vec3(0.7f, 0.4f, 0.3f));
-  std::uint32_t glass = addMaterial(s, glm::vec3(1.0f), 1.0f);
+  std::uint32_t floorMat = addMaterial(s, diffuseMaterial(0.8f));
+  std::uint32_t boxMat = addMaterial(s, diffuseMaterial(glm::vec3(0.7f, 0.4f, 0.3f)));
+  std::uint32_t glass = addMaterial(s, glassMaterial());
   addQuad(s, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, floorMat);
   addBox(s, glm::vec3(-1.2f, 0.0f, -0.6f), glm::vec3(-0.4f, 0.8f, 0.2f), boxMat);
   addSphere(s, glm::vec3(0.7f, 0.5f, 0.0f), 0.5f, 12, glass);
-  finish(s);
+  finishBounds(s);
   // Sun 2x2 texels of radiance 300 at about 40 degrees elevation, sky gradient, dim ground. (The test
   // "environment sun on a floor" checks mis against the exact answer under this map to 0.5 %.)
   s.environment = patchMap(64, 32, {{40, 6, glm::vec3(300.0f, 280.0f, 250.0f)}}, true, 0.0f);
-  Camera cam;
-  cam.position = glm::vec3(0.0f, 2.2f, 3.6f);
-  cam.forward = glm::normalize(glm::vec3(0.0f, 0.3f, 0.0f) - cam.position);
-  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
-  cam.yfov = 0.8f;
+  Camera cam = lookAt(glm::vec3(0.0f, 2.2f, 3.6f), glm::vec3(0.0f, 0.3f, 0.0f), 0.8f);
   // Measured (llvmpipe, 8 renders): standard error of the image mean ~0.45 % for naive at 512 spp,
   // ~0.14 % for mis at 64 spp, so this run detects a ~2.1 % bias of the image mean (printed).
   // CAUSTICA_LONG_TESTS=1 must detect 0.5 % (asserted). Measured: at 16x both, naive 0.115 % and mis
@@ -364,7 +306,7 @@ TEST_CASE("environment: naive and mis agree under a small bright sun (floor, box
   auto regions = [&](Integrator integ, int spp, std::uint32_t seedBase) {
     std::vector<std::array<double, 5>> out;
     for (int r = 0; r < renders; ++r) {
-      RenderSettings st = settingsFor(w, h, integ, seedBase + r);
+      RenderSettings st = smallSettings(w, h, integ, seedBase + r);
       st.maxDepth = 8;
       RenderResult res = renderScene(s, cam, st, spp);
       CHECK(res.stats.nonFinite == 0);
@@ -409,21 +351,17 @@ TEST_CASE("environment caustic: a glass ball focuses the sun into a bright spot 
   // ray through its centre reaches the floor 0.71 from the centre, just before the focus, at (0, 0, 0.5).
   Scene s;
   s.path = "caustic";
-  std::uint32_t floorMat = addMaterial(s, glm::vec3(0.8f));
-  std::uint32_t glass = addMaterial(s, glm::vec3(1.0f), 1.0f);
+  std::uint32_t floorMat = addMaterial(s, diffuseMaterial(0.8f));
+  std::uint32_t glass = addMaterial(s, glassMaterial());
   addQuad(s, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, floorMat);
   addSphere(s, glm::vec3(0.0f, 0.5f, 0.0f), 0.5f, 24, glass);
-  finish(s);
+  finishBounds(s);
   Environment env = patchMap(128, 64, {{31, 15, glm::vec3(500.0f)}}, false);
   for (size_t i = 0; i < env.rgb.size(); ++i) env.rgb[i] = std::max(env.rgb[i], 0.2f);
   s.environment = env;
-  Camera cam;
-  cam.position = glm::vec3(0.0f, 2.5f, 2.0f);
-  cam.forward = glm::normalize(glm::vec3(0.0f, 0.0f, 0.5f) - cam.position);
-  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
-  cam.yfov = 0.7f;
+  Camera cam = lookAt(glm::vec3(0.0f, 2.5f, 2.0f), glm::vec3(0.0f, 0.0f, 0.5f), 0.7f);
   const int w = 64, h = 64;
-  RenderResult r = renderScene(s, cam, settingsFor(w, h, Integrator::Mis), 128);
+  RenderResult r = renderScene(s, cam, smallSettings(w, h, Integrator::Mis), 128);
   CHECK(r.stats.nonFinite == 0);
   auto project = [&](glm::vec3 p) {  // pixel coordinates of world point p
     glm::vec3 d = p - cam.position;
@@ -472,8 +410,8 @@ TEST_CASE("environment sun on a floor: mis matches the exact irradiance of the m
   Scene s;
   s.path = "sun floor";
   const float albedo = 0.8f;
-  addQuad(s, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, {-20, 0, -20}, addMaterial(s, glm::vec3(albedo)));
-  finish(s);
+  addQuad(s, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, {-20, 0, -20}, addMaterial(s, diffuseMaterial(albedo)));
+  finishBounds(s);
   s.environment = patchMap(64, 32, {{40, 6, glm::vec3(300.0f, 280.0f, 250.0f)}}, true, 0.0f);
   const Environment& e = s.environment;
   glm::dvec3 irradiance(0.0);
@@ -485,11 +423,7 @@ TEST_CASE("environment sun on a floor: mis matches the exact irradiance of the m
   }
   const glm::dvec3 expected = double(albedo) / kPiD * irradiance;
   // Looking straight down from 1 above the floor: every pixel sees the floor.
-  Camera cam;
-  cam.position = glm::vec3(0.0f, 1.0f, 0.0f);
-  cam.forward = glm::vec3(0, -1, 0);
-  cam.up = glm::vec3(0, 0, -1);
-  cam.yfov = 0.8f;
+  Camera cam = cameraAt(glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0, -1, 0), glm::vec3(0, 0, -1), 0.8f);
   // Four renders of 16 x 16 at 256 spp (other seeds, ~5 s on llvmpipe); regions: the image and its four
   // quadrants, grey. Measured: standard error of the image mean 0.057 %, of a quadrant's 0.06-0.20 %
   // (from 4 renders; ~0.11 % expected, twice the image's); errors -0.19 % to +0.14 %. Tolerances: the
@@ -498,17 +432,11 @@ TEST_CASE("environment sun on a floor: mis matches the exact irradiance of the m
   const int w = 16, h = 16, renders = 4, spp = 256;
   std::array<double, 5> sum{}, sumSq{};
   for (int r = 0; r < renders; ++r) {
-    RenderSettings st = settingsFor(w, h, Integrator::Mis, 300 + r);
+    RenderSettings st = smallSettings(w, h, Integrator::Mis, 300 + r);
     st.maxDepth = 2;
     RenderResult res = renderScene(s, cam, st, spp, 64);
     CHECK(res.stats.nonFinite == 0);
-    std::array<double, 5> reg{};
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const double grey = (res.image.at(x, y, 0) + res.image.at(x, y, 1) + res.image.at(x, y, 2)) / 3.0;
-        reg[0] += grey / (w * h);
-        reg[1 + (y >= h / 2 ? 2 : 0) + (x >= w / 2 ? 1 : 0)] += grey / (w * h / 4.0);
-      }
+    const std::array<double, 5> reg = quadrantMeans(res.image);
     for (int k = 0; k < 5; ++k) {
       sum[k] += reg[k];
       sumSq[k] += reg[k] * reg[k];

@@ -50,9 +50,7 @@ std::vector<EstimatePoint> estimateAgainstReference(const std::string& file, int
                                                    int referenceSpp) {
   Scene scene = loadScene(sourcePath(file));
   Camera camera = sceneCamera(scene);
-  RenderSettings rs;
-  rs.width = w;
-  rs.height = h;
+  RenderSettings rs = smallSettings(w, h);
   const Reference ref = renderReference(scene, camera, rs, referenceSpp);
   const Image& reference = ref.image;
   const double referenceNoise = ref.noise;
@@ -91,9 +89,7 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
   // A scene without emitters (sun-glass) gets the default environment, as the command line gives it.
   if (!sceneHasLights(scene)) scene.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
   Camera camera = sceneCamera(scene);
-  RenderSettings rs;
-  rs.width = w;
-  rs.height = h;
+  RenderSettings rs = smallSettings(w, h);
   const Reference ref = renderReference(scene, camera, rs, referenceSpp);
   const Image& reference = ref.image;
   const double referenceNoise = ref.noise;
@@ -161,25 +157,12 @@ double quadrantMean(const Image& img, int qx, int qy) {
 // white wall lit by an area light out of view (noisy: its tiles keep sampling).
 Scene unevenNoiseScene() {
   Scene s;
-  Material wall;
-  wall.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(1.0f);
-  Material lamp = light;
-  lamp.emission = glm::vec3(4.0f);
-  s.materials = {wall, light, lamp};
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(1.0f), emitterMaterial(4.0f)};
   addQuad(s, {-2.0f, -2.0f, 0.0f}, {0.0f, -2.0f, 0.0f}, {0.0f, 2.0f, 0.0f}, {-2.0f, 2.0f, 0.0f}, 1);  // facing +z
   addQuad(s, {0.0f, -2.0f, 0.0f}, {2.0f, -2.0f, 0.0f}, {2.0f, 2.0f, 0.0f}, {0.0f, 2.0f, 0.0f}, 0);
   addQuad(s, {0.0f, 1.2f, 0.2f}, {1.0f, 1.2f, 0.2f}, {1.0f, 1.2f, 1.0f}, {0.0f, 1.2f, 1.0f}, 2);     // facing -y
-  for (const auto& t : s.triangles)
-    for (const auto& p : t.p) s.bounds.grow(p);
-  Camera cam;
-  cam.position = {0.0f, 0.0f, 2.0f};
-  cam.forward = {0.0f, 0.0f, -1.0f};
-  cam.up = {0.0f, 1.0f, 0.0f};
-  cam.yfov = 0.9f;
-  s.cameras.push_back(cam);
+  finishBounds(s);
+  s.cameras.push_back(cameraAt({0.0f, 0.0f, 2.0f}, {0.0f, 0.0f, -1.0f}, {0.0f, 1.0f, 0.0f}, 0.9f));
   return s;
 }
 
@@ -191,9 +174,7 @@ Scene unevenNoiseScene() {
 TEST_CASE("adaptive sampling: a pass samples exactly the pixels of the listed tiles, tiles of 1, 2, 4 and 8") {
   Scene scene = unevenNoiseScene();
   Camera camera = sceneCamera(scene);
-  RenderSettings rs;
-  rs.width = 21;
-  rs.height = 13;
+  RenderSettings rs = smallSettings(21, 13);
   for (int side : {1, 2, 4, 8}) {
     Renderer r(testShaderLibrary(), scene, camera, rs);
     const int tx = (rs.width + side - 1) / side, ty = (rs.height + side - 1) / side;
@@ -233,10 +214,7 @@ TEST_CASE("adaptive sampling: a pass samples exactly the pixels of the listed ti
 TEST_CASE("adaptive sampling: converges to the image of uniform sampling") {
   Scene scene = unevenNoiseScene();
   Camera camera = sceneCamera(scene);
-  RenderSettings rs;
-  rs.width = 48;
-  rs.height = 48;
-  rs.seed = 5;
+  RenderSettings rs = smallSettings(48, 48, Integrator::Mis, 5);
   Renderer uniform(testShaderLibrary(), scene, camera, rs);
   while (uniform.samplesPerPixel() < 3072) uniform.renderPass(64);
   const ErrorEstimate eu = uniform.errorEstimate();
@@ -298,10 +276,7 @@ TEST_CASE("adaptive sampling: on mirror-caustic the samples go to the mirror's c
   const Scene scene = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
   const auto info = readBenchScenes(sourcePath("bench/scenes.json"));
   REQUIRE(info.at("mirror-caustic").caustic);
-  RenderSettings rs;
-  rs.width = 64;
-  rs.height = 64;
-  rs.seed = 7;
+  RenderSettings rs = smallSettings(64, 64, Integrator::Mis, 7);
   const PixelRect crop = cropToPixels(*info.at("mirror-caustic").caustic, rs.width, rs.height);
   Renderer r(testShaderLibrary(), scene, sceneCamera(scene), rs);
   AdaptiveSampler sampler(0.02, true);
@@ -354,10 +329,7 @@ TEST_CASE("the all-features shader renders the specialised shader's image") {
                            "assets/scenes/cornell-glass.gltf"}) {
     Scene scene = loadScene(sourcePath(file));
     Camera camera = sceneCamera(scene);
-    RenderSettings rs;
-    rs.width = 32;
-    rs.height = 32;
-    rs.seed = 11;
+    RenderSettings rs = smallSettings(32, 32, Integrator::Mis, 11);
     Renderer specialised(testShaderLibrary(), scene, camera, rs);
     rs.allFeatures = true;
     Renderer all(testShaderLibrary(), scene, camera, rs);

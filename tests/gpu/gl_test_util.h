@@ -1,5 +1,5 @@
-// gl_test_util.h — helpers shared by the GPU tests: render a scene file or an in-memory scene and
-// get the linear image back, and per-region statistics.
+// gl_test_util.h — helpers shared by the GPU tests: render a scene file or an in-memory scene (built
+// with scene_builder.h) and get the linear image back, and per-region statistics.
 #pragma once
 #include <doctest/doctest.h>
 #include "scene/assets.h"
@@ -13,10 +13,12 @@
 #include <vector>
 
 #include "image/image_io.h"
+#include "gpu/gl_objects.h"
 #include "gpu/renderer.h"
 #include "scene/scene.h"
 #include "util/math_constants.h"
 #include "gpu/shader_library.h"
+#include "scene_builder.h"
 
 namespace caustica::test {
 
@@ -36,47 +38,27 @@ inline ShaderLibrary& testShaderLibrary() {
   return library;
 }
 
+// A test entry shader of glsl/tests ("tests/NAME.comp"), compiled with its log mapped to the library's files.
+inline GlProgram compileTestShader(const std::string& path) {
+  ExpandedShader src = testShaderLibrary().expand(path, {});
+  return GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); }, path);
+}
+
+// Settings of a small test render: w x h pixels, the integrator and the seed; all else the defaults.
+inline RenderSettings smallSettings(int w, int h, Integrator integrator = Integrator::Mis, std::uint32_t seed = 1) {
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.integrator = integrator;
+  s.seed = seed;
+  return s;
+}
+
 inline RenderResult renderScene(const Scene& scene, const Camera& camera, RenderSettings settings, int spp,
                                 int sppPerPass = 8) {
   Renderer r(testShaderLibrary(), scene, camera, settings);
   while (r.samplesPerPixel() < spp) r.renderPass(std::min(sppPerPass, spp - r.samplesPerPixel()));
   return {r.image(), r.stats(), r.shaderDefines()};
-}
-
-// A quad as two triangles with flat normals; a, b, c, d counter-clockwise seen from its front.
-inline void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material) {
-  glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-  for (auto tri : {std::array<glm::vec3, 3>{a, b, c}, std::array<glm::vec3, 3>{a, c, d}}) {
-    Triangle t{};
-    for (int i = 0; i < 3; ++i) {
-      t.p[i] = tri[i];
-      t.setNormal(i, n);
-    }
-    t.material = material;
-    s.triangles.push_back(t);
-  }
-}
-
-// A UV sphere of 2 * segments^2 triangles with smooth (radial) normals, outward fronts.
-inline void addSphere(Scene& s, glm::vec3 center, float radius, int segments, std::uint32_t material) {
-  auto point = [&](int i, int j) {
-    float theta = kPi * i / segments, phi = 2 * kPi * j / (2 * segments);
-    return glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
-  };
-  for (int i = 0; i < segments; ++i)
-    for (int j = 0; j < 2 * segments; ++j) {
-      glm::vec3 q[4] = {point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)};
-      for (auto idx : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
-        Triangle t{};
-        for (int k = 0; k < 3; ++k) {
-          t.setNormal(k, q[idx[k]]);
-          t.p[k] = center + radius * q[idx[k]];
-        }
-        if (glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) == 0.0f) continue;  // pole slivers
-        t.material = material;
-        s.triangles.push_back(t);
-      }
-    }
 }
 
 // A relative tolerance: |x - value| <= rel |value| + abs (doctest::Approx's epsilon is relative to
@@ -105,9 +87,33 @@ inline double meanOf(const Image& img, int channel = -1) {
   return sum / static_cast<double>(n);
 }
 
+// Grey means ((r + g + b) / 3) of the whole image and of its four quadrants: top left, top right,
+// bottom left, bottom right.
+inline std::array<double, 5> quadrantMeans(const Image& img) {
+  const int w = img.width, h = img.height;
+  std::array<double, 5> reg{};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double grey = (img.at(x, y, 0) + img.at(x, y, 1) + img.at(x, y, 2)) / 3.0;
+      reg[0] += grey / (w * h);
+      reg[1 + (y >= h / 2 ? 2 : 0) + (x >= w / 2 ? 1 : 0)] += grey / (w * h / 4.0);
+    }
+  return reg;
+}
+
 // Whether the shader variant `defines` holds `name` (the whole entry, value included).
 inline bool hasDefine(const std::vector<std::string>& defines, const std::string& name) {
   return std::find(defines.begin(), defines.end(), name) != defines.end();
+}
+
+// Float bits to uints and back (memcpy: glm's vector floatBitsToUint casts through a reference, which
+// GCC's aliasing rules break).
+template <class To, class From>
+To sameBits(const From& v) {
+  static_assert(sizeof(To) == sizeof(From));
+  To out;
+  std::memcpy(&out, &v, sizeof out);
+  return out;
 }
 
 // Floats that differ between two arrays, bit for bit (0: equal; different sizes count every value).

@@ -20,14 +20,6 @@ using namespace caustica::test;
 
 namespace {
 
-template <class To, class From>
-To sameBits(const From& v) {
-  static_assert(sizeof(To) == sizeof(From));
-  To out;
-  std::memcpy(&out, &v, sizeof out);
-  return out;
-}
-
 double relDiff(float a, float b) {
   if (a == b) return 0.0;
   return std::abs(static_cast<double>(a) - b) / std::max(std::abs(static_cast<double>(a)), std::abs(static_cast<double>(b)));
@@ -61,10 +53,7 @@ void checkTwins(const std::string& what, const std::vector<gpu::LightNode>& node
     in.push_back(glm::uvec4(q.node, 0u, 0u, 0u));
     qs.push_back(q);
   }
-  ShaderLibrary& library = testShaderLibrary();
-  ExpandedShader src = library.expand("tests/light_tree_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
-                                             "light_tree_test.comp");
+  GlProgram prog = compileTestShader("tests/light_tree_test.comp");
   GlBuffer nodeBuf = GlBuffer::fromVector(nodes);
   GlBuffer inBuf = GlBuffer::fromVector(in);
   GlBuffer outBuf = GlBuffer::create(sizeof(glm::uvec4) * 2 * n, nullptr, GL_DYNAMIC_READ);

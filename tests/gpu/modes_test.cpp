@@ -25,43 +25,10 @@ RenderSettings modeSettings(RenderMode mode, int size) {
   return s;
 }
 
-Camera lookAt(glm::vec3 eye, glm::vec3 target, float yfov) {
-  Camera c;
-  c.position = eye;
-  c.forward = glm::normalize(target - eye);
-  glm::vec3 worldUp = std::abs(c.forward.y) > 0.99f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
-  c.up = glm::normalize(glm::cross(glm::cross(c.forward, worldUp), c.forward));
-  c.yfov = yfov;
-  return c;
-}
-
-void finishBounds(Scene& s) {
-  s.bounds = Bounds{};
-  for (const auto& t : s.triangles)
-    for (const auto& p : t.p) s.bounds.grow(p);
-}
-
-// An axis-aligned box of outward-facing quads.
-void addBox(Scene& s, glm::vec3 lo, glm::vec3 hi, std::uint32_t m) {
-  glm::vec3 a(lo.x, lo.y, hi.z), b(hi.x, lo.y, hi.z), c(hi.x, hi.y, hi.z), d(lo.x, hi.y, hi.z);
-  glm::vec3 e(lo.x, lo.y, lo.z), f(hi.x, lo.y, lo.z), g(hi.x, hi.y, lo.z), h(lo.x, hi.y, lo.z);
-  addQuad(s, a, b, c, d, m);  // +z
-  addQuad(s, f, e, h, g, m);  // -z
-  addQuad(s, b, f, g, c, m);  // +x
-  addQuad(s, e, a, d, h, m);  // -x
-  addQuad(s, d, c, g, h, m);  // +y
-  addQuad(s, e, f, b, a, m);  // -y
-}
-
 // Floor (white diffuse), a small light high above and to the side, optionally a box on the floor.
 Scene shadowScene(bool withBox) {
   Scene s;
-  Material floor;
-  floor.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(2000.0f);
-  s.materials = {floor, light};
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(2000.0f)};
   addQuad(s, {-2.5f, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2.5f, 0, -2}, 0);
   // A 4 cm light 1.2 m up and 1.6 m to the side: the box's shadow reaches 1.9 m across the floor,
   // its penumbra at most 8 cm wide (the 50 % edge, where the masks are cut, is the point light's).
@@ -107,9 +74,10 @@ TEST_CASE("render modes: every mode renders every bundled scene") {
     bool envOnly = true;  // no emissive triangle: nothing the raster and Whitted modes light with
     for (const Triangle& t : scene.triangles) envOnly = envOnly && !scene.materials[t.material].isEmissive();
     Camera cam = sceneCamera(scene);
-    for (RenderMode mode : {RenderMode::Raster, RenderMode::Whitted, RenderMode::Path}) {
-      INFO(name, " in mode ", renderModeName(mode));
-      RenderResult r = renderScene(scene, cam, modeSettings(mode, 40), mode == RenderMode::Path ? 2 : 1);
+    for (const RenderModeSpec& spec : renderModes()) {
+      const RenderMode mode = spec.mode;
+      INFO(name, " in mode ", spec.name);
+      RenderResult r = renderScene(scene, cam, modeSettings(mode, 40), spec.samples == SampleRule::Regeneration ? 2 : 1);
       double sum = 0.0;
       bool finite = true;
       for (float v : r.image.rgb) {
@@ -118,7 +86,7 @@ TEST_CASE("render modes: every mode renders every bundled scene") {
       }
       CHECK(finite);
       CHECK(r.stats.nonFinite == 0);
-      if (!envOnly || mode == RenderMode::Path) CHECK(sum / static_cast<double>(r.image.rgb.size()) > 1e-3);  // not black
+      if (!envOnly || spec.seesEnvironment) CHECK(sum / static_cast<double>(r.image.rgb.size()) > 1e-3);  // not black
     }
   }
 }
@@ -147,12 +115,7 @@ TEST_CASE("render modes: the raster shadow of a box falls where the path tracer'
 
 TEST_CASE("render modes: Whitted and the path tracer agree on direct light from a small light on a diffuse plane") {
   Scene s;
-  Material floor;
-  floor.baseColor = glm::vec4(0.7f, 0.7f, 0.7f, 1.0f);
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(250.0f);
-  s.materials = {floor, light};
+  s.materials = {diffuseMaterial(0.7f), emitterMaterial(250.0f)};
   addQuad(s, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, 0);
   const float h = 0.02f;  // 4 cm square 1 m up: a point light to 1e-4 of the irradiance
   addQuad(s, {0.3f - h, 1, -h}, {0.3f + h, 1, -h}, {0.3f + h, 1, h}, {0.3f - h, 1, h}, 1);
@@ -193,18 +156,8 @@ TEST_CASE("render modes: Whitted and the path tracer agree on direct light from 
 
 TEST_CASE("render modes: a planar mirror shows the same reflected object in all three modes") {
   Scene s;
-  Material floor;
-  floor.baseColor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(60.0f);
-  Material mirror;
-  mirror.metallic = 1.0f;
-  mirror.roughness = 0.0f;
-  mirror.baseColor = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
-  Material red;
-  red.baseColor = glm::vec4(0.8f, 0.03f, 0.03f, 1.0f);
-  s.materials = {floor, light, mirror, red};
+  s.materials = {diffuseMaterial(0.5f), emitterMaterial(60.0f), metalMaterial(glm::vec3(0.9f)),
+                 diffuseMaterial(glm::vec3(0.8f, 0.03f, 0.03f))};
   addQuad(s, {-3, 0, 4}, {3, 0, 4}, {3, 0, -2}, {-3, 0, -2}, 0);
   addQuad(s, {-0.1f, 2.5f, 0.9f}, {0.1f, 2.5f, 0.9f}, {0.1f, 2.5f, 1.1f}, {-0.1f, 2.5f, 1.1f}, 1);
   addQuad(s, {-1.5f, 0.01f, -1}, {1.5f, 0.01f, -1}, {1.5f, 2, -1}, {-1.5f, 2, -1}, 2);  // facing +z
@@ -237,8 +190,7 @@ TEST_CASE("render modes: a planar mirror shows the same reflected object in all 
 
 TEST_CASE("render modes: the raster mesh finds planar mirrors and leaves a mirror ball to highlights") {
   Scene s;
-  Material diffuse, mirror;
-  mirror.metallic = 1.0f;
+  const Material diffuse, mirror = metalMaterial(glm::vec3(1.0f));
   s.materials = {diffuse, mirror};
   addQuad(s, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, 1);            // a planar mirror floor
   addQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 1, -1}, {-1, 1, -1}, 0);          // a diffuse wall
@@ -294,10 +246,7 @@ TEST_CASE("render modes: pointLightIntensity and phongBrdf agree with their C++ 
     lights.push_back(l);
     args.push_back(a);
   }
-  ShaderLibrary& library = testShaderLibrary();
-  ExpandedShader src = library.expand("tests/modes_twins_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
-                                             "modes_twins_test.comp");
+  GlProgram prog = compileTestShader("tests/modes_twins_test.comp");
   GlBuffer inBuf = GlBuffer::fromVector(in);
   GlBuffer outBuf = GlBuffer::create(sizeof(glm::vec4) * 2 * n, nullptr, GL_DYNAMIC_READ);
   prog.use();

@@ -22,30 +22,19 @@ constexpr int kSize = 48;
 Scene planeScene() {
   Scene s;
   s.path = "plane";
-  Material m;
-  m.baseColor = glm::vec4(kAlbedo, kAlbedo, kAlbedo, 1.0f);
-  s.materials.push_back(m);
+  s.materials.push_back(diffuseMaterial(kAlbedo));
   addQuad(s, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, {-10, 0, -10}, 0);
-  for (const Triangle& t : s.triangles)
-    for (const glm::vec3& p : t.p) s.bounds.grow(p);
+  finishBounds(s);
   return s;
 }
 
 Camera topCamera() {
-  Camera c;
-  c.position = glm::vec3(0.0f, 3.0f, 0.0f);
-  c.forward = glm::vec3(0.0f, -1.0f, 0.0f);
-  c.up = glm::vec3(0.0f, 0.0f, -1.0f);
-  c.yfov = 60.0f * kPi / 180.0f;
-  return c;
+  return cameraAt(glm::vec3(0.0f, 3.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f), glm::vec3(0.0f, 0.0f, -1.0f), 60.0f * kPi / 180.0f);
 }
 
 RenderSettings settings(Integrator integrator = Integrator::Mis, std::uint32_t seed = 1) {
-  RenderSettings s;
-  s.width = s.height = kSize;
+  RenderSettings s = smallSettings(kSize, kSize, integrator, seed);
   s.maxDepth = 4;
-  s.integrator = integrator;
-  s.seed = seed;
   return s;
 }
 
@@ -240,9 +229,7 @@ TEST_CASE("punctual: a directional light gives albedo / pi * E cos(theta) everyw
   CHECK(lo == Rel(expected, 1e-4));  // no randomness at all: every sample is the same
   CHECK(hi == Rel(expected, 1e-4));
   // An occluder casts a hard shadow: a small quad at y = 1 hides the plane below it along the light.
-  Material black;
-  black.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  s.materials.push_back(black);
+  s.materials.push_back(diffuseMaterial(0.0f));
   addQuad(s, {-0.2f, 1, 0.2f}, {0.2f, 1, 0.2f}, {0.2f, 1, -0.2f}, {-0.2f, 1, -0.2f}, 1);
   Image img = renderScene(s, topCamera(), settings(), 4).image;
   // The shadow's centre: from (0, 1, 0) along the light's direction down to y = 0.

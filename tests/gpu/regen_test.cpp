@@ -53,51 +53,27 @@ void checkSame(const Scene& scene, const Camera& camera, const RenderSettings& r
   CHECK(one.stats.nonFinite == many.stats.nonFinite);
 }
 
-RenderSettings small(Integrator integ, std::uint32_t seed = 5) {
-  RenderSettings rs;
-  rs.width = 24;
-  rs.height = 16;
-  rs.seed = seed;
-  rs.integrator = integ;
-  return rs;
-}
+RenderSettings small(Integrator integ, std::uint32_t seed = 5) { return smallSettings(24, 16, integ, seed); }
 
 // Under a uniform sky: a diffuse floor, a glass ball, a half-transparent (alpha 0.5) cut-out sheet
 // and a mirror, seen against a transparent background: cut-outs, coverage and long glass paths.
 Scene cutoutScene() {
   Scene s;
   s.path = "regen test";
-  Material floor;
-  floor.baseColor = glm::vec4(0.6f, 0.5f, 0.4f, 1.0f);
-  Material glass;
-  glass.baseColor = glm::vec4(1.0f);
-  glass.transmission = 1.0f;
-  glass.ior = 1.5f;
   Material sheet;
   sheet.baseColor = glm::vec4(0.2f, 0.7f, 0.3f, 0.5f);
-  Material mirror;
-  mirror.baseColor = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
-  mirror.metallic = 1.0f;
-  s.materials = {floor, glass, sheet, mirror};
+  s.materials = {diffuseMaterial(glm::vec3(0.6f, 0.5f, 0.4f)), glassMaterial(1.5f), sheet, metalMaterial(glm::vec3(0.9f))};
   addQuad(s, {-2, -1, 1}, {2, -1, 1}, {2, -1, -5}, {-2, -1, -5}, 0);
   addSphere(s, {-0.4f, -0.4f, -3.0f}, 0.6f, 16, 1);
   addQuad(s, {0.1f, -1, -2.2f}, {1.2f, -1, -2.2f}, {1.2f, 0.6f, -2.2f}, {0.1f, 0.6f, -2.2f}, 2);
   addQuad(s, {0.5f, -1, -4.0f}, {1.8f, -1, -3.5f}, {1.8f, 1.0f, -3.5f}, {0.5f, 1.0f, -4.0f}, 3);
-  for (const Triangle& t : s.triangles)
-    for (const auto& q : t.p) s.bounds.grow(q);
+  finishBounds(s);
   s.environment = uniformEnvironment(glm::vec3(1.0f));
   s.background.kind = Background::Kind::Transparent;
   return s;
 }
 
-Camera frontCamera() {
-  Camera c;
-  c.position = glm::vec3(0.0f, 0.0f, 0.5f);
-  c.forward = glm::vec3(0, -0.15f, -1);
-  c.up = glm::vec3(0, 1, 0);
-  c.yfov = 0.9f;
-  return c;
-}
+Camera frontCamera() { return cameraAt(glm::vec3(0.0f, 0.0f, 0.5f), glm::vec3(0, -0.15f, -1), glm::vec3(0, 1, 0), 0.9f); }
 
 }  // namespace
 

@@ -20,15 +20,6 @@ using namespace caustica::test;
 
 namespace {
 
-RenderSettings small(int w, int h, Integrator integrator, std::uint32_t seed = 1) {
-  RenderSettings s;
-  s.width = w;
-  s.height = h;
-  s.integrator = integrator;
-  s.seed = seed;
-  return s;
-}
-
 // Per-block means of several independent renders (different seeds) for a statistical comparison.
 struct BlockStats {
   int blocksX = 0, blocksY = 0;
@@ -46,20 +37,13 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
   size_t nb = static_cast<size_t>(b.blocksX) * b.blocksY * 3;
   std::vector<std::vector<double>> per(renders, std::vector<double>(nb, 0.0));
   for (int r = 0; r < renders; ++r) {
-    RenderSettings settings = small(w, h, integrator, seedBase + r);
+    RenderSettings settings = smallSettings(w, h, integrator, seedBase + r);
     settings.maxDepth = maxDepth;
     settings.casterProbability = casterProbability;
     RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     if (defines) *defines = res.defines;
-    std::array<double, 5> reg{};
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const double grey = (res.image.at(x, y, 0) + res.image.at(x, y, 1) + res.image.at(x, y, 2)) / 3.0;
-        reg[0] += grey / (w * h);
-        reg[1 + (y >= h / 2 ? 2 : 0) + (x >= w / 2 ? 1 : 0)] += grey / (w * h / 4.0);
-      }
-    b.regions.push_back(reg);
+    b.regions.push_back(quadrantMeans(res.image));
     for (int y = 0; y < b.blocksY * block; ++y)
       for (int x = 0; x < b.blocksX * block; ++x)
         for (int c = 0; c < 3; ++c)
@@ -145,7 +129,7 @@ TEST_CASE("furnace: walls of albedo 0.5 emitting 1 give radiance 2 everywhere") 
   for (const char* file : {"tests/data/scenes/furnace.gltf", "tests/data/scenes/furnace-glass.gltf"}) {
     Scene scene = loadScene(sourcePath(file));
     for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
-      RenderResult r = renderScene(scene, sceneCamera(scene), small(32, 32, integ), 64);
+      RenderResult r = renderScene(scene, sceneCamera(scene), smallSettings(32, 32, integ), 64);
       INFO(file, " ", std::string(integratorName(integ)));
       for (int c = 0; c < 3; ++c) CHECK(meanOf(r.image, c) == Rel(2.0, 0.01));
       // Pixels more than 30 % off: none where every path sees the same walls; the glass furnace's
@@ -164,7 +148,7 @@ TEST_CASE("furnace: walls of albedo 0.5 emitting 1 give radiance 2 everywhere") 
 TEST_CASE("a clear glass sphere inside a uniformly emitting black enclosure is invisible") {
   Scene scene = loadScene(sourcePath("tests/data/scenes/glass-in-white-enclosure.gltf"));
   for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
-    RenderSettings settings = small(32, 32, integ);
+    RenderSettings settings = smallSettings(32, 32, integ);
     settings.maxDepth = 256;  // rays caught by total internal reflection near the rim need many bounces
     RenderResult r = renderScene(scene, sceneCamera(scene), settings, 32);
     INFO(std::string(integratorName(integ)));
@@ -203,9 +187,9 @@ TEST_CASE("naive and mis converge to the same image: bunny-shaped light") {
 
 TEST_CASE("same seed, same image; another seed, another image") {
   Scene scene = loadScene(sourcePath("tests/data/scenes/small-cornell.gltf"));
-  RenderResult a = renderScene(scene, sceneCamera(scene), small(16, 16, Integrator::Mis, 5), 4, 4);
-  RenderResult b = renderScene(scene, sceneCamera(scene), small(16, 16, Integrator::Mis, 5), 4, 1);  // other split
-  RenderResult c = renderScene(scene, sceneCamera(scene), small(16, 16, Integrator::Mis, 6), 4, 4);
+  RenderResult a = renderScene(scene, sceneCamera(scene), smallSettings(16, 16, Integrator::Mis, 5), 4, 4);
+  RenderResult b = renderScene(scene, sceneCamera(scene), smallSettings(16, 16, Integrator::Mis, 5), 4, 1);  // other split
+  RenderResult c = renderScene(scene, sceneCamera(scene), smallSettings(16, 16, Integrator::Mis, 6), 4, 4);
   double maxDiff = 0, otherDiff = 0;
   for (size_t i = 0; i < a.image.rgb.size(); ++i) {
     maxDiff = std::max(maxDiff, double(std::abs(a.image.rgb[i] - b.image.rgb[i])));
@@ -221,8 +205,8 @@ TEST_CASE("Renderer::apply: a renderer whose settings changed renders what a new
   // fresh renderer's with those settings (same variant, same accumulation restart).
   Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
   ShaderLibrary& library = testShaderLibrary();
-  RenderSettings first = small(12, 10, Integrator::Naive, 3);
-  RenderSettings second = small(16, 12, Integrator::Mis, 9);
+  RenderSettings first = smallSettings(12, 10, Integrator::Naive, 3);
+  RenderSettings second = smallSettings(16, 12, Integrator::Mis, 9);
   second.maxDepth = 7;
   second.casterProbability = 0.3f;
   Renderer changed(library, scene, sceneCamera(scene), first);
@@ -253,28 +237,15 @@ namespace {
 // A floor, a small light above it and a glass sphere between them whose focus lies on the floor.
 Scene causticScene(float dispersion) {
   Scene s;
-  Material floor;
-  floor.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(18.0f);
-  Material glass;
-  glass.transmission = 1.0f;
-  glass.ior = 1.5f;
+  Material glass = glassMaterial(1.5f);
   glass.dispersion = dispersion;
-  s.materials = {floor, light, glass};
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(18.0f), glass};
   addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);  // floor, facing +y
   float h = 0.15f;
   addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);               // light, facing -y
   addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
-  for (const auto& t : s.triangles)
-    for (const auto& p : t.p) s.bounds.grow(p);
-  Camera cam;
-  cam.position = {0.0f, 1.4f, 1.9f};
-  cam.forward = glm::normalize(glm::vec3(0.0f, 0.0f, 0.0f) - cam.position);
-  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
-  cam.yfov = 0.9f;
-  s.cameras.push_back(cam);
+  finishBounds(s);
+  s.cameras.push_back(lookAt({0.0f, 1.4f, 1.9f}, {0.0f, 0.0f, 0.0f}, 0.9f));
   return s;
 }
 
@@ -312,7 +283,7 @@ TEST_CASE("the refraction caustic appears under the glass sphere, brighter than 
   const Camera& cam = scene.cameras[0];
   const int n = 64;
   for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
-    RenderResult r = renderScene(scene, cam, small(n, n, integ), 256);
+    RenderResult r = renderScene(scene, cam, smallSettings(n, n, integ), 256);
     // Focus: the floor straight under the sphere (the ball lens images the small light there).
     // Shadow: the outer ring of the sphere's shadow (radius about 0.4), past the spread of the
     // focused light: converged (naive 4096 spp, mis 1024 spp) it is 0.3 x the lit floor; the ring
@@ -366,7 +337,7 @@ TEST_CASE("mis aiming at the glass ball (caustic casters) matches naive and find
 TEST_CASE("rgb and spectral dispersion agree in mean brightness, and spread the caustic into colours") {
   Scene scene = causticScene(1.0f);
   const int n = 48;
-  RenderSettings rgb = small(n, n, Integrator::Mis);
+  RenderSettings rgb = smallSettings(n, n, Integrator::Mis);
   RenderSettings spectral = rgb;
   spectral.dispersion = DispersionMode::Spectral;
   RenderResult a = renderScene(scene, scene.cameras[0], rgb, 96);
@@ -452,7 +423,7 @@ void checkRegionsAgree(const Scene& scene, const std::string& file, int sppNaive
   const int n = 32;
   std::uint64_t nonFinite = 0;
   auto render = [&](Integrator integ, std::uint32_t seed, int spp) {
-    RenderSettings settings = small(n, n, integ, seed);
+    RenderSettings settings = smallSettings(n, n, integ, seed);
     settings.maxDepth = 2;
     RenderResult r = renderScene(scene, cam, settings, spp, 64);
     nonFinite += r.stats.nonFinite;
@@ -568,29 +539,18 @@ double ggxAlbedo(double cosO, double alpha) {
 TEST_CASE("furnace: a rough metal with F0 = 1 reflects its GGX directional albedo with naive and mis") {
   for (float roughness : {0.3f, 0.6f, 1.0f}) {
     Scene s;
-    Material metal;
-    metal.baseColor = glm::vec4(1.0f);
-    metal.metallic = 1.0f;
-    metal.roughness = roughness;
-    Material sky;
-    sky.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-    sky.emission = glm::vec3(1.0f);
+    Material sky = emitterMaterial(1.0f);
     sky.doubleSided = true;
-    s.materials = {metal, sky};
+    s.materials = {metalMaterial(glm::vec3(1.0f), roughness), sky};
     addQuad(s, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, 0);  // facing +z
     addSphere(s, {0, 0, 0}, 6.0f, 12, 1);
-    for (const auto& t : s.triangles)
-      for (const auto& p : t.p) s.bounds.grow(p);
-    Camera cam;
-    cam.position = {0.0f, 0.0f, 3.0f};
-    cam.forward = {0.0f, 0.0f, -1.0f};
-    cam.up = {0.0f, 1.0f, 0.0f};
-    cam.yfov = 0.04f;
+    finishBounds(s);
+    const Camera cam = cameraAt({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, {0.0f, 1.0f, 0.0f}, 0.04f);
     const double expected = ggxAlbedo(1.0, double(roughness) * roughness);
     for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
       const int n = 48;
       // Roughness 1 reflects least and noisiest (relative): 2.5 times the samples.
-      RenderResult r = renderScene(s, cam, small(n, n, integ, 3), roughness < 1.0f ? 256 : 640, 64);
+      RenderResult r = renderScene(s, cam, smallSettings(n, n, integ, 3), roughness < 1.0f ? 256 : 640, 64);
       CHECK(std::find(r.defines.begin(), r.defines.end(), "CAUSTICA_GGX") != r.defines.end());
       double mean = 0, var = 0;  // of the pixels' grey values, which are independent estimates
       std::vector<double> grey;
@@ -635,22 +595,15 @@ TEST_CASE("naive and mis agree per region: one GGX lobe filling the view") {
       m.specularF0 = glm::vec3(0.04f);
       m.specularF90 = 1.0f;
     }
-    Material light;
-    light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-    light.emission = glm::vec3(4.0f);
-    s.materials = {m, light};
+    s.materials = {m, emitterMaterial(4.0f)};
     addQuad(s, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, 0);  // facing +y
     const float h = kind == 2 ? 0.5f : 0.4f, y = kind == 2 ? -0.3f : 1.0f;  // the pane's light lies under all it shows
     if (kind == 2) addQuad(s, {-h, y, h}, {h, y, h}, {h, y, -h}, {-h, y, -h}, 1);  // facing +y, below the pane
     else addQuad(s, {-h, y, -h}, {h, y, -h}, {h, y, h}, {-h, y, h}, 1);           // facing -y, above the floor
-    for (const auto& t : s.triangles)
-      for (const auto& p : t.p) s.bounds.grow(p);
-    Camera cam;  // the pane is seen from above, narrowly, so every pixel sees the light through it
-    cam.position = kind == 2 ? glm::vec3(0.0f, 2.0f, 0.3f) : glm::vec3(0.0f, 1.6f, 1.6f);
-    cam.forward = glm::normalize((kind == 2 ? glm::vec3(0.0f) : glm::vec3(0.0f, 0.0f, -0.3f)) - cam.position);
-    cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
-    cam.yfov = kind == 2 ? 0.35f : 0.9f;
-    s.cameras.push_back(cam);
+    finishBounds(s);
+    // The pane is seen from above, narrowly, so every pixel sees the light through it.
+    s.cameras.push_back(kind == 2 ? lookAt({0.0f, 2.0f, 0.3f}, glm::vec3(0.0f), 0.35f)
+                                  : lookAt({0.0f, 1.6f, 1.6f}, {0.0f, 0.0f, -0.3f}, 0.9f));
     const char* names[] = {"rough gold floor", "red plastic floor", "frosted pane over a light"};
     checkRegionsAgree(s, names[kind], 4096, 2048, 900 + 10 * kind, 4.0);
   }
@@ -665,12 +618,7 @@ TEST_CASE("naive and mis agree per region: one GGX lobe filling the view") {
 // latter from the single-direction cosine by 0.07 %).
 TEST_CASE("normal maps and KHR_texture_transform change the shading normal as the texel says") {
   Scene s;
-  Material floor;
-  floor.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(50.0f);
-  s.materials = {floor, light};
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(50.0f)};
   Texture map;
   map.width = 2;
   map.height = 1;
@@ -693,14 +641,9 @@ TEST_CASE("normal maps and KHR_texture_transform change the shading normal as th
   const float h = 0.3f;
   addQuad(s, {-h, h, 8}, {h, h, 8}, {h, -h, 8}, {-h, -h, 8}, 1);  // facing -z, down onto the square
   s.texcoords.resize(s.triangles.size());  // one per triangle: the light's (0, 0)
-  for (const auto& t : s.triangles)
-    for (const auto& q : t.p) s.bounds.grow(q);
-  Camera cam;
-  cam.position = {0.0f, -0.5f, 3.0f};
-  cam.forward = glm::normalize(glm::vec3(0.0f) - cam.position);
-  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
-  cam.yfov = 0.3f;
-  auto render = [&](const Scene& scene) { return meanOf(renderScene(scene, cam, small(24, 24, Integrator::Mis, 5), 32).image); };
+  finishBounds(s);
+  const Camera cam = lookAt({0.0f, -0.5f, 3.0f}, glm::vec3(0.0f), 0.3f);
+  auto render = [&](const Scene& scene) { return meanOf(renderScene(scene, cam, smallSettings(24, 24, Integrator::Mis, 5), 32).image); };
   const double plain = render(s);
   Scene mapped = s;
   mapped.materials[0].normalTexture = 0;

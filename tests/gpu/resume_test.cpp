@@ -15,10 +15,7 @@ using namespace caustica::test;
 TEST_CASE("resume from a checkpoint: 8 spp + 8 spp equals 16 spp bit for bit") {
   Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
   Camera camera = sceneCamera(scene);
-  RenderSettings rs;
-  rs.width = 16;
-  rs.height = 12;
-  rs.seed = 11;
+  const RenderSettings rs = smallSettings(16, 12, Integrator::Mis, 11);
   ShaderLibrary& library = testShaderLibrary();
   std::string path = (std::filesystem::temp_directory_path() / "caustica-resume-test.ckpt").string();
 

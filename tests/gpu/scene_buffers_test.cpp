@@ -40,9 +40,7 @@ Scene splitScene(int checkerSide = 2) {
   Material floor;
   floor.baseColor = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
   floor.baseColorTexture = 0;
-  Material light;
-  light.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  light.emission = glm::vec3(12.0f);
+  const Material light = emitterMaterial(12.0f);
   Material ball;
   ball.baseColor = glm::vec4(0.8f, 0.4f, 0.2f, 1.0f);
   ball.baseColorTexture = 0;
@@ -56,14 +54,8 @@ Scene splitScene(int checkerSide = 2) {
       const glm::vec3& p = s.triangles[i].p[k];
       s.texcoords[i].uv[k] = glm::vec2(p.x * 2.0f, p.z * 2.0f + p.y);  // texcoords everywhere
     }
-  for (const auto& t : s.triangles)
-    for (const auto& p : t.p) s.bounds.grow(p);
-  Camera cam;
-  cam.position = {0.0f, 1.6f, 3.2f};
-  cam.forward = glm::normalize(glm::vec3(0.0f, 0.5f, 0.0f) - cam.position);
-  cam.up = glm::normalize(glm::cross(glm::cross(cam.forward, glm::vec3(0, 1, 0)), cam.forward));
-  cam.yfov = 0.8f;
-  s.cameras.push_back(cam);
+  finishBounds(s);
+  s.cameras.push_back(lookAt({0.0f, 1.6f, 3.2f}, {0.0f, 0.5f, 0.0f}, 0.8f));
   return s;
 }
 
@@ -99,8 +91,9 @@ bool hasDefineStartingWith(const std::vector<std::string>& d, const std::string&
 
 TEST_CASE("scene buffers: a scene split over several storage blocks renders the same image, bit for bit") {
   const Scene scene = splitScene();
-  for (RenderMode mode : {RenderMode::Path, RenderMode::Whitted, RenderMode::Raster}) {
-    const std::string modeName = renderModeName(mode);
+  for (const RenderModeSpec& spec : renderModes()) {
+    const RenderMode mode = spec.mode;
+    const std::string modeName = spec.name;
     CAPTURE(modeName);
     const SplitRender whole = render(scene, mode, 8);
     CHECK(whole.layout.extraBlocks() == 0);

@@ -1,5 +1,5 @@
 // shader_library_test.cpp — include expansion, define injection, log mapping, and glslang
-// validation of every shader variant (every combination of feature defines), without a GL context.
+// validation of the shader variants (combinations of the shader-feature table's rows), without a GL context.
 #include <doctest/doctest.h>
 
 #include <unistd.h>
@@ -12,6 +12,8 @@
 #include <glslang/Public/ShaderLang.h>
 
 #include "util/error.h"
+#include "gpu/render_mode.h"
+#include "gpu/shader_features.h"
 #include "gpu/shader_library.h"
 #include "shared/gpu_layout.h"
 
@@ -86,78 +88,45 @@ TEST_CASE("include cycles expand each file once; missing files and #version line
   fs::remove_all(dir);
 }
 
-TEST_CASE("pathtrace.comp compiles with every combination of up to 3 features, and all but up to 2 (glslang, GLSL 4.30 core)") {
-  // The full cross product (2^11 variants) takes minutes; every feature is an #ifdef block, so what can
-  // break is how up to a few of them meet: every triple, and every set missing at most two features
-  // (the dense variants real scenes use), covers that.
+TEST_CASE("every render mode's entry shader compiles with every combination of up to 3 of its feature rows, and all but up to 2 (glslang, GLSL 4.30 core)") {
+  // The rows are the shader-feature table's (app/gpu/shader_features.cpp) that the mode compiles. The
+  // full cross product (2^15 variants of pathtrace.comp) takes hours; every feature is an #ifdef block,
+  // so what can break is how up to a few of them meet: every triple, and every set missing at most
+  // two rows (the dense variants real scenes use), covers that. Sets where a row lacks the row it
+  // needs (casters without mis) are never compiled and are skipped.
   ShaderLibrary lib;
-  const auto& names = shaderFeatureNames();
-  REQUIRE(names.size() <= 16);
-  const unsigned all = (1u << names.size()) - 1u;
-  int variants = 0;
-  for (unsigned mask = 0; mask <= all; ++mask) {
-    int on = __builtin_popcount(mask);
-    if (on > 3 && on < static_cast<int>(names.size()) - 2) continue;
-    std::vector<std::string> defines;
-    for (size_t i = 0; i < names.size(); ++i)
-      if (mask & (1u << i)) defines.push_back(names[i]);
-    std::string log = validate(lib.expand("pathtrace.comp", defines));
-    std::string label;
-    for (const auto& d : defines) label += d + " ";
-    INFO("defines: ", label);
-    REQUIRE_MESSAGE(log.empty(), log);
-    ++variants;
-  }
-  MESSAGE(variants, " variants compiled");
-}
-
-TEST_CASE("the punctual-light variants compile on top of every integrator and material feature") {
-  // CAUSTICA_PUNCTUAL and CAUSTICA_SPOT_EMITTERS with each feature alone and with all of them (the
-  // full cross product with the features above would be 4x as many variants).
-  ShaderLibrary lib;
-  const auto& names = shaderFeatureNames();
-  std::vector<std::vector<std::string>> bases = {{}, names};
-  for (const auto& n : names) bases.push_back({n});
-  for (const auto& extra : std::vector<std::vector<std::string>>{
-           {"CAUSTICA_PUNCTUAL"}, {"CAUSTICA_SPOT_EMITTERS"}, {"CAUSTICA_PUNCTUAL", "CAUSTICA_SPOT_EMITTERS"}})
-    for (auto defines : bases) {
-      defines.insert(defines.end(), extra.begin(), extra.end());
-      std::string label;
-      for (const auto& d : defines) label += d + " ";
+  const auto& table = shaderFeatureTable();
+  for (const RenderModeSpec& mode : renderModes()) {
+    if (!mode.entryShader) continue;
+    std::vector<std::size_t> rows;
+    const FeatureSet modeRows = modeFeatureRows(mode.mode);
+    for (std::size_t i = 0; i < table.size(); ++i)
+      if (modeRows.test(i)) rows.push_back(i);
+    REQUIRE(rows.size() <= 20);
+    int variants = 0;
+    for (unsigned mask = 0; mask < (1u << rows.size()); ++mask) {
+      const int on = __builtin_popcount(mask);
+      if (on > 3 && on < static_cast<int>(rows.size()) - 2) continue;
+      std::vector<std::string> defines;
+      bool possible = true;
+      for (std::size_t k = 0; k < rows.size(); ++k) {
+        if (!(mask & (1u << k))) continue;
+        const ShaderFeature& row = table[rows[k]];
+        defines.push_back(row.define);
+        if (row.needs) {
+          const auto at = std::find(rows.begin(), rows.end(), shaderFeatureIndex(row.needs));
+          possible = possible && at != rows.end() && (mask & (1u << (at - rows.begin())));
+        }
+      }
+      if (!possible) continue;
+      std::string label = mode.entryShader + std::string(":");
+      for (const auto& d : defines) label += " " + d;
       INFO("defines: ", label);
-      const std::string log = validate(lib.expand("pathtrace.comp", defines));
+      const std::string log = validate(lib.expand(mode.entryShader, defines));
       REQUIRE_MESSAGE(log.empty(), log);
+      ++variants;
     }
-}
-
-TEST_CASE("the transparent-background variant (coverage image) compiles in both tracers on top of every feature") {
-  ShaderLibrary lib;
-  const auto& names = shaderFeatureNames();
-  std::vector<std::vector<std::string>> bases = {{}, names};
-  for (const auto& n : names) bases.push_back({n});
-  for (const char* entry : {"pathtrace.comp", "whitted.comp"})
-    for (auto defines : bases) {
-      defines.push_back("CAUSTICA_TRANSPARENT");
-      std::string label = entry + std::string(": ");
-      for (const auto& d : defines) label += d + " ";
-      INFO("defines: ", label);
-      const std::string log = validate(lib.expand(entry, defines));
-      REQUIRE_MESSAGE(log.empty(), log);
-    }
-}
-
-TEST_CASE("the no-emitter variant (mis for the environment alone) compiles on top of every feature") {
-  ShaderLibrary lib;
-  const auto& names = shaderFeatureNames();
-  std::vector<std::vector<std::string>> bases = {{"CAUSTICA_MIS", "CAUSTICA_ENV"}, names};
-  for (const auto& n : names) bases.push_back({"CAUSTICA_MIS", "CAUSTICA_ENV", n});
-  for (auto defines : bases) {
-    defines.push_back("CAUSTICA_NO_EMITTERS");
-    std::string label;
-    for (const auto& d : defines) label += d + " ";
-    INFO("defines: ", label);
-    const std::string log = validate(lib.expand("pathtrace.comp", defines));
-    REQUIRE_MESSAGE(log.empty(), log);
+    MESSAGE(std::string(mode.entryShader), ": ", variants, " variants compiled");
   }
 }
 
@@ -171,10 +140,12 @@ TEST_CASE("the other entry shaders compile") {
   }
 }
 
-TEST_CASE("split storage blocks (split_buffers.glsl): 2 to 4 parts of the TriShade words compile in both compute modes") {
+TEST_CASE("split storage blocks (split_buffers.glsl): 2 to 4 parts of the TriShade words compile in every compute mode") {
   ShaderLibrary lib;
   for (int parts = 2; parts <= CAUSTICA_MAX_SPLIT_PARTS; ++parts)
-    for (const char* entry : {"pathtrace.comp", "whitted.comp"}) {
+    for (const RenderModeSpec& mode : renderModes()) {
+      if (!mode.entryShader) continue;
+      const char* entry = mode.entryShader;
       // Bindings as app/gpu/scene_buffers.cpp hands them out: 7, 8, ...
       std::vector<std::string> defines = {"CAUSTICA_TEXTURES", "CAUSTICA_TRISHADE_TEXCOORDS", "CAUSTICA_MIS", "CAUSTICA_GLASS"};
       int next = CAUSTICA_BINDING_SPLIT_FIRST;
@@ -205,22 +176,6 @@ std::string validateGraphics(const ExpandedShader& vs, const ExpandedShader& fs)
   program.addShader(&f);
   if (!program.link(EShMsgDefault)) return program.getInfoLog();
   return "";
-}
-
-TEST_CASE("render modes: every material feature combination of whitted.comp compiles (glslang, GLSL 4.30 core)") {
-  ShaderLibrary lib;
-  const std::vector<std::string> materialFeatures = {"CAUSTICA_MIRROR",    "CAUSTICA_GLASS",    "CAUSTICA_VOLUME",
-                                                     "CAUSTICA_DISPERSION", "CAUSTICA_TEXTURES", "CAUSTICA_OPACITY"};
-  for (unsigned mask = 0; mask < (1u << materialFeatures.size()); ++mask) {
-    std::vector<std::string> defines;
-    for (size_t i = 0; i < materialFeatures.size(); ++i)
-      if (mask & (1u << i)) defines.push_back(materialFeatures[i]);
-    std::string log = validate(lib.expand("whitted.comp", defines));
-    std::string label;
-    for (const auto& d : defines) label += d + " ";
-    INFO("defines: ", label);
-    REQUIRE_MESSAGE(log.empty(), log);
-  }
 }
 
 TEST_CASE("render modes: the raster programs (vertex + fragment stages) compile and link (glslang)") {

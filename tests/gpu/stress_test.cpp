@@ -92,10 +92,7 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
     // A scene without emitters (sun-glass) gets the default environment, as the command line gives it.
     const bool unlit = !sceneHasLights(original);
     if (unlit) original.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
-    RenderSettings settings;
-    settings.width = 48;
-    settings.height = 48;
-    settings.seed = 3;
+    const RenderSettings settings = smallSettings(48, 48, Integrator::Mis, 3);
     RenderResult ref = renderScene(original, sceneCamera(original), settings, spp, spp);
     const double refMean = meanOf(ref.image);
     std::vector<PixelRect> regions = {{0, 0, 24, 24}, {24, 0, 48, 24}, {0, 24, 24, 48}, {24, 24, 48, 48}};
@@ -127,64 +124,9 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
 
 namespace {
 
-Material diffuse(float albedo, float emission = 0.0f) {
-  Material m;
-  m.baseColor = glm::vec4(glm::vec3(albedo), 1.0f);
-  m.emission = glm::vec3(emission);
-  return m;
-}
-
-Material glass() {
-  Material m;
-  m.transmission = 1.0f;
-  m.ior = 1.5f;
-  return m;
-}
-
-void finish(Scene& s) {
-  s.bounds = Bounds{};
-  for (const Triangle& t : s.triangles)
-    for (const glm::vec3& p : t.p) s.bounds.grow(p);
-}
-
-Camera lookAt(glm::vec3 eye, glm::vec3 target, float yfov, glm::vec3 up = glm::vec3(0, 1, 0)) {
-  Camera c;
-  c.position = eye;
-  c.forward = glm::normalize(target - eye);
-  c.up = glm::normalize(up - glm::dot(up, c.forward) * c.forward);
-  c.yfov = yfov;
-  return c;
-}
-
-// A closed box [-h, h]^3 whose six faces face inwards.
-void addInwardBox(Scene& s, float h, std::uint32_t material) {
-  const glm::vec3 c[8] = {{-h, -h, -h}, {h, -h, -h}, {h, h, -h}, {-h, h, -h}, {-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h}};
-  addQuad(s, c[0], c[1], c[2], c[3], material);  // back (z = -h), seen from inside
-  addQuad(s, c[5], c[4], c[7], c[6], material);  // front
-  addQuad(s, c[4], c[0], c[3], c[7], material);  // left
-  addQuad(s, c[1], c[5], c[6], c[2], material);  // right
-  addQuad(s, c[4], c[5], c[1], c[0], material);  // floor
-  addQuad(s, c[3], c[2], c[6], c[7], material);  // ceiling
-}
-
-// An outward-facing axis-aligned box between lo and hi.
-void addBox(Scene& s, glm::vec3 lo, glm::vec3 hi, std::uint32_t material) {
-  const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
-                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  addQuad(s, c[1], c[0], c[3], c[2], material);
-  addQuad(s, c[4], c[5], c[6], c[7], material);
-  addQuad(s, c[0], c[4], c[7], c[3], material);
-  addQuad(s, c[5], c[1], c[2], c[6], material);
-  addQuad(s, c[0], c[1], c[5], c[4], material);
-  addQuad(s, c[7], c[6], c[2], c[3], material);
-}
-
 RenderSettings settingsFor(int n, Integrator integrator, int maxDepth = 32, std::uint32_t seed = 1) {
-  RenderSettings s;
-  s.width = s.height = n;
-  s.integrator = integrator;
+  RenderSettings s = smallSettings(n, n, integrator, seed);
   s.maxDepth = maxDepth;
-  s.seed = seed;
   return s;
 }
 
@@ -194,10 +136,10 @@ TEST_CASE("stress: total internal reflection chains: a glass cube in a uniformly
   // Every path that leaves the glass carries the enclosure's radiance 1; paths caught by total
   // internal reflection in the cube's corners need many bounces, so the depth cap is high.
   Scene s;
-  s.materials = {diffuse(0.0f, 1.0f), glass()};
-  addInwardBox(s, 2.0f, 0);
+  s.materials = {emitterMaterial(1.0f), glassMaterial()};
+  addBox(s, glm::vec3(-2.0f), glm::vec3(2.0f), 0, /*inward=*/true);
   addBox(s, glm::vec3(-0.5f), glm::vec3(0.5f), 1);
-  finish(s);
+  finishBounds(s);
   const Camera cam = lookAt(glm::vec3(1.2f, 0.9f, 1.5f), glm::vec3(0.0f), 0.9f);
   for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
     RenderResult r = renderScene(s, cam, settingsFor(32, integ, 1024), 32);
@@ -219,12 +161,12 @@ TEST_CASE("stress: a light of radiance 1e6 and area 1e-6 lights the floor as the
   // A 1 mm square light 1 unit above a floor of albedo 0.5, nothing else: the floor's radiance at
   // distance d from the light, height h, is (albedo / pi) Le A h^2 / d^4 (both cosines h / d).
   Scene s;
-  s.materials = {diffuse(0.5f), diffuse(0.0f, 1.0e6f)};
+  s.materials = {diffuseMaterial(0.5f), emitterMaterial(1.0e6f)};
   addQuad(s, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, 0);  // floor, facing up
   const float e = 0.0005f;
   addQuad(s, {-e, 1, -e}, {e, 1, -e}, {e, 1, e}, {-e, 1, e}, 1);  // light, facing down
-  finish(s);
-  const Camera cam = lookAt(glm::vec3(0, 3, 0), glm::vec3(0), 0.8f, glm::vec3(0, 0, -1));
+  finishBounds(s);
+  const Camera cam = lookAt(glm::vec3(0, 3, 0), glm::vec3(0), 0.8f);
   const int n = 32;
   RenderResult r = renderScene(s, cam, settingsFor(n, Integrator::Mis), 16);
   CHECK(r.stats.nonFinite == 0);
@@ -250,7 +192,7 @@ TEST_CASE("stress: a light of 10^5 triangles gives the image of the same light a
   // Same square, same radiance: one quad, or a 224 x 224 grid of quads (100,352 triangles).
   auto scene = [](int grid) {
     Scene s;
-    s.materials = {diffuse(0.5f), diffuse(0.0f, 4.0f)};
+    s.materials = {diffuseMaterial(0.5f), emitterMaterial(4.0f)};
     addQuad(s, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, 0);
     const float h = 0.25f, step = 2.0f * h / grid;
     for (int i = 0; i < grid; ++i)
@@ -258,7 +200,7 @@ TEST_CASE("stress: a light of 10^5 triangles gives the image of the same light a
         const float x0 = -h + i * step, z0 = -h + j * step;
         addQuad(s, {x0, 1, z0}, {x0 + step, 1, z0}, {x0 + step, 1, z0 + step}, {x0, 1, z0 + step}, 1);
       }
-    finish(s);
+    finishBounds(s);
     return s;
   };
   const Scene one = scene(1), many = scene(224);
@@ -284,12 +226,12 @@ TEST_CASE("stress: the camera inside geometry: a closed furnace sphere, and a cl
   // inside a closed sphere that neither emits nor is lit, it is 0 (and not NaN).
   for (float emission : {1.0f, 0.0f}) {
     Scene s;
-    s.materials = {diffuse(0.5f, emission)};
+    s.materials = {diffuseMaterial(0.5f, emission)};
     addSphere(s, glm::vec3(0), 1.0f, 24, 0);
     for (Triangle& t : s.triangles) std::swap(t.p[1], t.p[2]);  // fronts face inwards
     for (Triangle& t : s.triangles)
       for (int k = 0; k < 3; ++k) t.setNormal(k, -t.normal(k));
-    finish(s);
+    finishBounds(s);
     const Camera cam = lookAt(glm::vec3(0.2f, 0.1f, 0.3f), glm::vec3(1, 0, 0), 1.2f);
     for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
       RenderResult r = renderScene(s, cam, settingsFor(16, integ, 256), 32);
@@ -310,7 +252,7 @@ TEST_CASE("stress: slivers, degenerate triangles and grazing views give the imag
   // see docs/stability.md.)
   auto scene = [](bool slivers) {
     Scene s;
-    s.materials = {diffuse(0.5f), diffuse(0.0f, 5.0f)};
+    s.materials = {diffuseMaterial(0.5f), emitterMaterial(5.0f)};
     const float w = 1000.0f;
     if (!slivers) {
       addQuad(s, {-w, 0, w}, {w, 0, w}, {w, 0, -w}, {-w, 0, -w}, 0);
@@ -331,7 +273,7 @@ TEST_CASE("stress: slivers, degenerate triangles and grazing views give the imag
         }
     }
     addQuad(s, {-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}, 1);
-    finish(s);
+    finishBounds(s);
     return s;
   };
   const Scene plain = scene(false), sliver = scene(true);
@@ -357,11 +299,11 @@ TEST_CASE("stress: a glass sheet 1e-4 thick transmits (1 - R) / (1 + R) of what 
   // normal incidence for n = 1.5 (the camera side is black). Needs robust spawning: the two faces
   // are 1e-4 apart.
   Scene s;
-  s.materials = {diffuse(0.0f, 1.0f), glass()};
+  s.materials = {emitterMaterial(1.0f), glassMaterial()};
   addQuad(s, {-5, -5, -3}, {5, -5, -3}, {5, 5, -3}, {-5, 5, -3}, 0);  // emitting wall, facing +z
   const float t = 1e-4f;
   addBox(s, glm::vec3(-2, -2, -t), glm::vec3(2, 2, 0), 1);
-  finish(s);
+  finishBounds(s);
   const Camera cam = lookAt(glm::vec3(0, 0, 2), glm::vec3(0, 0, -1), 0.1f);
   const double r0 = 0.04, expected = (1.0 - r0) / (1.0 + r0);
   for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
@@ -414,11 +356,11 @@ TEST_CASE("stress: coincident and nested dielectric surfaces stay finite, and ne
   // answer; they must only stay finite.
   for (bool coincident : {false, true}) {
     Scene s;
-    s.materials = {diffuse(0.0f, 1.0f), glass()};
-    addInwardBox(s, 2.0f, 0);
+    s.materials = {emitterMaterial(1.0f), glassMaterial()};
+    addBox(s, glm::vec3(-2.0f), glm::vec3(2.0f), 0, /*inward=*/true);
     addSphere(s, glm::vec3(0), 0.6f, 24, 1);
     addSphere(s, glm::vec3(0), coincident ? 0.6f : 0.3f, 24, 1);
-    finish(s);
+    finishBounds(s);
     const Camera cam = lookAt(glm::vec3(0.3f, 0.2f, 1.8f), glm::vec3(0.0f), 0.8f);
     for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
       RenderResult r = renderScene(s, cam, settingsFor(24, integ, 1024), 32);

@@ -19,14 +19,7 @@ namespace {
 
 // Camera at the origin looking down -Z with tan(yfov / 2) = 0.5: on the plane z = -2 the image spans
 // x, y in [-1, 1], so pixel column c of a w-wide image starts at x = 2c / w - 1.
-Camera frontCamera() {
-  Camera c;
-  c.position = glm::vec3(0.0f);
-  c.forward = glm::vec3(0, 0, -1);
-  c.up = glm::vec3(0, 1, 0);
-  c.yfov = 2.0f * std::atan(0.5f);
-  return c;
-}
+Camera frontCamera() { return cameraAt(glm::vec3(0.0f), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0), 2.0f * std::atan(0.5f)); }
 
 constexpr int kSize = 32;
 // The diffuse wall's left edge crosses pixel column 20 at 0.3 of its width: that column is 70 % wall.
@@ -39,31 +32,16 @@ constexpr float kEdgeX = 2.0f * kEdgeColumn / kSize - 1.0f;
 Scene wallAndBall(Background::Kind background) {
   Scene s;
   s.path = "transparent test";
-  Material wall;
-  wall.baseColor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
-  s.materials.push_back(wall);
-  Material glass;
-  glass.baseColor = glm::vec4(1.0f);
-  glass.transmission = 1.0f;
-  glass.ior = 1.5f;
-  s.materials.push_back(glass);
+  s.materials = {diffuseMaterial(0.5f), glassMaterial(1.5f)};
   addQuad(s, {kEdgeX, -5.0f, -2.0f}, {5.0f, -5.0f, -2.0f}, {5.0f, 5.0f, -2.0f}, {kEdgeX, 5.0f, -2.0f}, 0);
   addSphere(s, {-1.0f, 0.0f, -4.0f}, 0.5f, 24, 1);
-  for (const Triangle& t : s.triangles)
-    for (const auto& q : t.p) s.bounds.grow(q);
+  finishBounds(s);
   s.environment = uniformEnvironment(glm::vec3(1.0f));
   s.background.kind = background;
   return s;
 }
 
-RenderSettings settings(Integrator integrator, std::uint32_t seed = 3) {
-  RenderSettings rs;
-  rs.width = kSize;
-  rs.height = kSize;
-  rs.integrator = integrator;
-  rs.seed = seed;
-  return rs;
-}
+RenderSettings settings(Integrator integrator, std::uint32_t seed = 3) { return smallSettings(kSize, kSize, integrator, seed); }
 
 float alphaAt(const Image& img, int x, int y) { return img.alpha[static_cast<size_t>(y) * img.width + x]; }
 

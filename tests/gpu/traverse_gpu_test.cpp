@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "accel/bvh_wide.h"
 #include "accel/spawn.h"
 #include "accel/tlas.h"
@@ -47,9 +48,7 @@ void traceOnGpu(const Bvh& bvh, const std::vector<gpu::BvhWideNode>& wide, const
   GlBuffer rayBuf = GlBuffer::fromVector(rays);
   GlBuffer hitBuf = GlBuffer::create(sizeof(glm::vec4) * rayCount, nullptr);
   GlBuffer occBuf = GlBuffer::create(sizeof(std::uint32_t) * rayCount, nullptr);
-  ShaderLibrary& lib = test::testShaderLibrary();
-  ExpandedShader src = lib.expand("tests/trace_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/trace_test.comp");
+  GlProgram prog = test::compileTestShader("tests/trace_test.comp");
   prog.use();
   BvhTextures textures(nodes, bvh.nodes.size(), geomBuf, geom.size(), "traverse test", wide);
   textures.bind();
@@ -349,10 +348,7 @@ TEST_CASE("instanced GPU traversal (traverse_instanced.glsl) equals its C++ twin
   GlBuffer rayBuf = GlBuffer::fromVector(rays);
   GlBuffer hitBuf = GlBuffer::create(sizeof(glm::uvec4) * rayCount, nullptr);
   GlBuffer occBuf = GlBuffer::create(sizeof(glm::uvec2) * rayCount, nullptr);
-  ShaderLibrary& lib = test::testShaderLibrary();
-  ExpandedShader src = lib.expand("tests/trace_instanced_test.comp", {});
-  GlProgram prog = GlProgram::compileCompute(src.source, [&](const std::string& l) { return src.mapLog(l); },
-                                             "tests/trace_instanced_test.comp");
+  GlProgram prog = test::compileTestShader("tests/trace_instanced_test.comp");
   prog.use();
   BvhTextures textures(nodes, texels.size(), geomBuf, two.tris.size(), "instanced traverse test");
   textures.bind();

@@ -23,8 +23,10 @@
 #include "shading/texture_wrap.h"
 #include "shading/sampling.h"
 #include "scene/punctual_lights.h"
+#include "gl_test_util.h"
 
 using namespace caustica;
+using caustica::test::sameBits;
 
 namespace {
 
@@ -38,16 +40,6 @@ enum class Fn : GLuint {
 };
 
 constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
-
-// Float bits to uints and back (memcpy: glm's vector floatBitsToUint casts through a reference, which
-// GCC's aliasing rules break).
-template <class To, class From>
-To sameBits(const From& v) {
-  static_assert(sizeof(To) == sizeof(From));
-  To out;
-  std::memcpy(&out, &v, sizeof out);
-  return out;
-}
 
 // One input record: the shader reads word k as uints (raw[k]) or as float bits (a[k]).
 struct In {
@@ -81,11 +73,7 @@ static_assert(sizeof(In) == kInWords * 16 && sizeof(Out) == kOutWords * 16, "rec
 // twins_test.comp, compiled once per test case; run() calls one function on every record.
 class GlslTwins {
  public:
-  GlslTwins() {
-    ExpandedShader src = ShaderLibrary().expand("tests/twins_test.comp", {});
-    prog_ = GlProgram::compileCompute(
-        src.source, [&](const std::string& l) { return src.mapLog(l); }, "tests/twins_test.comp");
-  }
+  GlslTwins() : prog_(test::compileTestShader("tests/twins_test.comp")) {}
   std::vector<Out> run(Fn fn, const std::vector<In>& in, const gpu::CasterParams& casters = {}) const {
     GlBuffer inBuf = GlBuffer::fromVector(in);
     GlBuffer outBuf = GlBuffer::create(sizeof(Out) * in.size(), nullptr);

@@ -63,33 +63,33 @@ void writePattern(const std::string& path, int w, int h, Imf::Compression compre
 
 TEST_CASE("EXR: named layers round-trip, float exactly and half to the nearest half") {
   const int w = 7, h = 5;
-  ExrLayer main{"", {"R", "G", "B", "A"}, {}, false};
-  ExrLayer albedo{"albedo", {"R", "G", "B"}, {}, true};
-  ExrLayer normal{"normal", {"X", "Y", "Z"}, {}, false};
+  ImageLayer main{"", {"R", "G", "B", "A"}, {}, false};
+  ImageLayer albedo{"albedo", {"R", "G", "B"}, {}, true};
+  ImageLayer normal{"normal", {"X", "Y", "Z"}, {}, false};
   for (int i = 0; i < w * h; ++i) {
-    for (int c = 0; c < 4; ++c) main.values.push_back(1000.0f * float(i) + 0.1234567f * float(c) + 1e-7f);
-    for (int c = 0; c < 3; ++c) albedo.values.push_back(0.001f * float(i * 3 + c));
-    for (int c = 0; c < 3; ++c) normal.values.push_back(-1.0f + 0.01f * float(i + c));
+    for (int c = 0; c < 4; ++c) main.data.push_back(1000.0f * float(i) + 0.1234567f * float(c) + 1e-7f);
+    for (int c = 0; c < 3; ++c) albedo.data.push_back(0.001f * float(i * 3 + c));
+    for (int c = 0; c < 3; ++c) normal.data.push_back(-1.0f + 0.01f * float(i + c));
   }
   const std::string path = tempPath("layers.exr");
   writeExrLayers(path, w, h, {main, albedo, normal});
   int rw = 0, rh = 0;
-  const std::vector<ExrLayer> back = readExrLayers(path, rw, rh);
+  const std::vector<ImageLayer> back = readExrLayers(path, rw, rh);
   CHECK(rw == w);
   CHECK(rh == h);
   REQUIRE(back.size() == 3);
-  for (const ExrLayer& l : back) {
-    const ExrLayer& src = l.name.empty() ? main : l.name == "albedo" ? albedo : normal;
-    REQUIRE(l.values.size() == src.values.size());
+  for (const ImageLayer& l : back) {
+    const ImageLayer& src = l.name.empty() ? main : l.name == "albedo" ? albedo : normal;
+    REQUIRE(l.data.size() == src.data.size());
     // Channels come back in the file's alphabetical order: map by name.
     for (std::size_t c = 0; c < l.channels.size(); ++c) {
       std::size_t s = 0;
       while (src.channels[s] != l.channels[c]) ++s;
       int off = 0;
       for (int i = 0; i < w * h; ++i) {
-        const float want = src.half ? float(half(src.values[std::size_t(i) * src.channels.size() + s]))
-                                    : src.values[std::size_t(i) * src.channels.size() + s];
-        off += l.values[std::size_t(i) * l.channels.size() + c] != want;
+        const float want = src.half ? float(half(src.data[std::size_t(i) * src.channels.size() + s]))
+                                    : src.data[std::size_t(i) * src.channels.size() + s];
+        off += l.data[std::size_t(i) * l.channels.size() + c] != want;
       }
       CHECK_MESSAGE(off == 0, l.name << "." << l.channels[c]);
     }
@@ -97,8 +97,28 @@ TEST_CASE("EXR: named layers round-trip, float exactly and half to the nearest h
   CHECK(colorLayer(back)->name.empty());
   const Image img = readImage(path);  // the main layer, with its alpha
   REQUIRE(img.alpha.size() == std::size_t(w * h));
-  CHECK(img.rgb[3 * 4 + 1] == main.values[4 * 4 + 1]);
-  CHECK(img.alpha[6] == main.values[6 * 4 + 3]);
+  CHECK(img.rgb[3 * 4 + 1] == main.data[4 * 4 + 1]);
+  CHECK(img.alpha[6] == main.data[6 * 4 + 3]);
+  fs::remove(path);
+}
+
+TEST_CASE("EXR: an image with AOV layers (writeExrLayers of image_io.h) reads back as the image and its layers") {
+  Image img{4, 2, std::vector<float>(4 * 2 * 3), std::vector<float>(4 * 2, 0.5f)};
+  for (std::size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = 0.25f * float(i);
+  ImageLayer depth{"depth", {"Z"}, std::vector<float>(8, 3.0f)};
+  const std::string path = tempPath("aov.exr");
+  writeExrLayers(path, img, {depth});
+  const Image back = readImage(path);
+  CHECK(back.rgb == img.rgb);
+  CHECK(back.alpha == img.alpha);
+  int w = 0, h = 0;
+  const std::vector<ImageLayer> layers = readExrLayers(path, w, h);
+  REQUIRE(layers.size() == 2);
+  CHECK(layers[1].name == "depth");
+  CHECK(layers[1].data == depth.data);
+  CHECK_THROWS_WITH_AS(writeExrLayers(path, img, {ImageLayer{"", {"Z"}, depth.data}}), doctest::Contains("unnamed"), Error);
+  CHECK_THROWS_WITH_AS(writeExrLayers(path, img, {ImageLayer{"d", {"Z"}, {1.0f}}}), doctest::Contains("holds 1 values"),
+                       Error);
   fs::remove(path);
 }
 
@@ -181,7 +201,7 @@ TEST_CASE("EXR: multi-part files, layered channels and luminance-only images") {
       beauty.writePixels(h);
     }
     int rw = 0, rh = 0;
-    const std::vector<ExrLayer> layers = readExrLayers(path, rw, rh);
+    const std::vector<ImageLayer> layers = readExrLayers(path, rw, rh);
     REQUIRE(layers.size() == 2);
     CHECK(layers[0].name == "depth");
     CHECK(layers[1].name == "beauty");

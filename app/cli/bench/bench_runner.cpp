@@ -129,13 +129,13 @@ class BenchRunner {
 
     Renderer renderer(library, ls.scene, ls.camera, settings);
     std::vector<DispersionMode> modes;
-    if (renderer.gpuScene().features.dispersion) modes = dispersions_;
+    if (renderer.sceneFeatures().has("CAUSTICA_DISPERSION")) modes = dispersions_;
     else modes = {DispersionMode::Rgb};  // the mode changes nothing without dispersive glass
     if (opts_.has("--reference") && modes.size() != 1)
       throw Error("--reference gives one image but " + name + " is benchmarked in " + std::to_string(modes.size()) +
                   " dispersion modes: pick one with --dispersion");
     note(quiet_, name + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, features: " +
-                     renderer.gpuScene().features.describe() + "; " + std::to_string(settings.width) + "x" +
+                     renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
                      std::to_string(settings.height) +
                      (caustic ? ", caustic region " + std::to_string(caustic->width()) + "x" +
                                     std::to_string(caustic->height()) + " px at (" + std::to_string(caustic->x0) +

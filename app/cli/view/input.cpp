@@ -66,9 +66,7 @@ void applyKeys(GlfwWindow& window, CameraController& controller, ViewControls& c
       case GLFW_KEY_R: controller.reset(); break;
       case GLFW_KEY_F: c.fly = !c.fly; break;
       case GLFW_KEY_M:
-        c.wanted.mode = c.wanted.mode == RenderMode::Path                        ? RenderMode::Whitted
-                        : c.wanted.mode == RenderMode::Whitted && c.rasterAllowed ? RenderMode::Raster
-                                                                                 : RenderMode::Path;
+        c.wanted.mode = nextRenderMode(c.wanted.mode, c.instancedScene);
         std::cout << "caustica: render mode " << renderModeName(c.wanted.mode) << "\n" << std::flush;
         break;
       case GLFW_KEY_I:

@@ -22,7 +22,7 @@ struct ViewControls {
   bool redraw = true;              // the shown image is out of date (restart, exposure, damage...)
   bool stopAtTarget = false;       // G: stop refining once the estimated relMSE reaches targetError
   double targetError = 0.01;       // relMSE (--target-error; G toggles stopping there)
-  bool rasterAllowed = true;       // false for an instanced scene (raster draws flat ones): M skips it
+  bool instancedScene = false;     // M skips the modes that draw flat scenes only (RenderModeSpec::instancedScenes)
 };
 
 class ViewerInput {

@@ -40,8 +40,8 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   scene_ = loadSceneForCli(opts, !config_.quiet, kDefaultWidth);  // every image setting, the scene's applied
   sceneName_ = fileStem(scene_.scene.path);
   RenderSettings settings = scene_.settings.render;
-  if (settings.mode == RenderMode::Raster) flattenForRaster(scene_.scene, opts, config_.quiet);
-  controls_.rasterAllowed = scene_.scene.instances.empty();  // M skips raster for an instanced scene
+  flattenForMode(scene_.scene, settings.mode, opts, config_.quiet);  // raster draws flat scenes
+  controls_.instancedScene = !scene_.scene.instances.empty();  // M skips the modes that draw flat scenes only
   controls_.wanted = settings;
   controls_.tone = scene_.settings.tone;
   controls_.stopAtTarget = config_.targetError > 0.0;
@@ -68,7 +68,7 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   controller_ = std::make_unique<CameraController>(scene_.camera, scene_.scene.bounds);
   appliedRevision_ = controller_->revision();
   note(config_.quiet, scene_.scene.path + ": " + std::to_string(scene_.scene.triangles.size()) + " triangles, features: " +
-                          renderer_->gpuScene().features.describe() + "; " + std::to_string(fullW_) + "x" +
+                          renderer_->sceneFeatures().describe() + "; " + std::to_string(fullW_) + "x" +
                           std::to_string(fullH_) + ", " + integratorName(controls_.wanted.integrator) +
                           "; press H for the controls");
   double x = 0.0, y = 0.0;
@@ -206,7 +206,7 @@ void Viewer::updateTitle(bool force) {
   lastTitle_ = t;
   const RenderSettings& wanted = controls_.wanted;
   std::string title = "caustica view - " + sceneName_ + " | " +
-                      lightingTag(scene_.scene, renderer_->gpuScene().emitters.size()) + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
+                      lightingTag(scene_.scene, renderer_->gpuScene().emitterCount) + " | " + std::to_string(renderer_->samplesPerPixel()) + " spp | " +
                       format("%.3g samples/s", samplesPerSecond_) + " | " + format("%.1f ms/frame", frameMs_) + " | " +
                       integratorName(wanted.integrator) +
                       (wanted.integrator == Integrator::Mis && !renderer_->gpuScene().casters.empty()
