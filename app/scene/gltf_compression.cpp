@@ -23,11 +23,6 @@
 namespace caustica::gltf {
 namespace {
 
-const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
-  const auto it = map.find(name);
-  return it == map.end() || !it->second.IsObject() ? nullptr : &it->second;
-}
-
 // A non-negative integer property of an extension object (already type-checked by checkJson), or fallback.
 std::uint64_t count(const tinygltf::Value& v, const char* key, std::uint64_t fallback) {
   if (!v.Has(key)) return fallback;

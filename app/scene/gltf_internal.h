@@ -98,6 +98,12 @@ void restoreDracoIndices(tinygltf::Model& model, const JsonFacts& facts);
 void decodeMeshoptViews(const std::string& path, tinygltf::Model& model, const std::vector<std::size_t>& fallback,
                         const LoadOptions& options);
 
+// The object of extension `name` in an extensions map, or nullptr (absent, or not an object).
+inline const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
+  const auto it = map.find(name);
+  return it == map.end() || !it->second.IsObject() ? nullptr : &it->second;
+}
+
 // ---- byte access (gltf_accessors.cpp) ------------------------------------------------------------
 // True when `count` elements of `elem` bytes, `stride` bytes apart, starting at `offset`, lie inside
 // `length` bytes. Written without products that could overflow.

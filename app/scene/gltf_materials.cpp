@@ -14,11 +14,6 @@
 namespace caustica::gltf {
 namespace {
 
-const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
-  const auto it = map.find(name);
-  return it == map.end() || !it->second.IsObject() ? nullptr : &it->second;
-}
-
 double extNumber(const tinygltf::Value* ext, const char* key, double fallback) {
   if (!ext || !ext->Has(key) || !ext->Get(key).IsNumber()) return fallback;
   return ext->Get(key).GetNumberAsDouble();

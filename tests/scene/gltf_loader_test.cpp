@@ -1120,3 +1120,46 @@ TEST_CASE("instancing: autoInstances keeps instances only where flattening multi
       CHECK(flat.triangles[i].normalWord[k] == four.triangles[i].normalWord[k]);
     }
 }
+
+TEST_CASE("nothing dropped in silence: what is not rendered is named in one warning line") {
+  TempDir dir;
+  Gltf g;
+  const int pos = g.positions(kTriangle);
+  const int colors = g.accessor(std::vector<float>{1, 1, 1, 1, 1, 1, 1, 1, 1}, kFloat, "VEC3");
+  const int joints = g.accessor(std::vector<std::uint8_t>{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, kByte, "VEC4");
+  const int weights = g.accessor(std::vector<float>{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, kFloat, "VEC4");
+  const int mat = g.add("materials", {{"name", "aged"}, {"occlusionTexture", {{"index", 0}}}});
+  const unsigned char png[4] = {255, 255, 255, 255};
+  REQUIRE(stbi_write_png((dir.path / "ao.png").string().c_str(), 1, 1, 4, png, 4));
+  g.doc["images"] = {{{"uri", "ao.png"}}};
+  g.doc["textures"] = {{{"source", 0}}};
+  const int mesh = g.mesh({{"attributes", {{"POSITION", pos}, {"COLOR_1", colors}, {"JOINTS_0", joints},
+                                           {"WEIGHTS_0", weights}, {"_BATCHID", colors}}},
+                           {"targets", json::array({{{"POSITION", pos}}})},
+                           {"material", mat}});
+  g.root({{"mesh", mesh}, {"skin", 0}});
+  g.doc["skins"] = {{{"joints", {0}}}};
+  g.doc["animations"] = {{{"channels", json::array()}, {"samplers", json::array()}}};
+  g.doc["scenes"].push_back({{"nodes", json::array()}});
+  g.doc["extensionsUsed"] = {"KHR_materials_sheen", "KHR_materials_clearcoat"};
+  const Scene s = g.load(dir);
+  std::vector<std::string> lines;
+  for (const std::string& w : s.warnings)
+    if (w.find("not rendered: ") != std::string::npos) lines.push_back(w);
+  REQUIRE(lines.size() == 1);
+  const std::string& line = lines[0];
+  CHECK(line.rfind(s.path + ": not rendered: ", 0) == 0);
+  for (const char* named : {"extension(s) KHR_materials_clearcoat, KHR_materials_sheen", "animations (1;",
+                            "skins (1; meshes drawn in their bind pose)", "morph targets of meshes[0]",
+                            "vertex attribute(s) COLOR_1, JOINTS_0, WEIGHTS_0, _BATCHID",
+                            "1 scene(s) besides the default one", "'aged': occlusionTexture"}) {
+    CAPTURE(std::string(named));
+    CHECK(line.find(named) != std::string::npos);
+  }
+  SUBCASE("a file with nothing unsupported gets no such line") {
+    Gltf plain;
+    const int m = plain.diffuse();
+    plain.root({{"mesh", plain.mesh({{"attributes", {{"POSITION", plain.positions(kTriangle)}}}, {"material", m}})}});
+    for (const std::string& w : plain.load(dir, "plain.gltf").warnings) CHECK(w.find("not rendered") == std::string::npos);
+  }
+}
