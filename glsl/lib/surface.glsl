@@ -58,8 +58,8 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : sf.ngFront;
   if (dot(ns, sf.ngFront) < 0.0) ns = -ns;
   sf.uv = b0 * st0 + hit.u * st1 + hit.v * st2;
-  sf.color = vec4(1.0);
-#ifdef CAUSTICA_VERTEX_COLORS
+  sf.color = vec4(1.0);  // exactly white where the scene has no colours (also under --all-features)
+#if defined(CAUSTICA_VERTEX_COLORS) && defined(CAUSTICA_TRISHADE_COLORS)
   vec4 sc0, sc1, sc2;
 #ifdef CAUSTICA_INSTANCED
   instanceColors(hit.tri, xf, sc0, sc1, sc2);
