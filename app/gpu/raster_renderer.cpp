@@ -28,7 +28,8 @@ bool isMirrorMaterial(const gpu::Material& m) { return m.params.x >= 0.5f && !is
 
 // Uniform locations (raster.vert / raster.frag / shadow.*).
 constexpr GLint kUViewProj = 0, kUClipPlane = 1, kUEye = 2, kUBaseColor = 3, kUEmission = 4, kUParams = 5,
-                kUHasTexture = 6, kUPlanarMirror = 7, kUShadowTexels = 8, kUVertexAlpha = 9, kULightPosFar = 1;
+                kUHasTexture = 6, kUPlanarMirror = 7, kUShadowTexels = 8, kUVertexAlpha = 9, kUVertexColors = 10,
+                kULightPosFar = 1;
 
 }  // namespace
 
@@ -133,7 +134,7 @@ RasterMesh buildRasterMesh(const GpuScene& scene) {
 }
 
 RasterRenderer::RasterRenderer(const ShaderLibrary& library, const GpuScene& scene, const gpu::PointLights& lights)
-    : materials_(scene.materials) {
+    : materials_(scene.materials), vertexColors_(scene.triShadeLayout.colors) {
   mesh_ = buildRasterMesh(scene);
   auto compile = [&](const char* vs, const char* fs) {
     ExpandedShader v = library.expand(vs, {});
@@ -311,6 +312,7 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadowMaps_.id());
   glUniform1f(kUShadowTexels, static_cast<float>(kShadowMapTexels));
+  glUniform1i(kUVertexColors, vertexColors_ ? 1 : 0);
 
   // 1. The opaque scene; planar mirrors first get a plain surface like everything else.
   drawOpaqueScene(viewProj, eye, kKeepAll, -1);

@@ -68,6 +68,7 @@ class RasterRenderer {
   void drawTransparent(const glm::mat4& viewProj, const glm::vec3& eye);
 
   std::vector<gpu::Material> materials_;
+  bool vertexColors_ = false;  // the scene has COLOR_0: the vertices' colours multiply the base colour
   RasterMesh mesh_;
   GlBuffer vertexBuffer_, indexBuffer_;
   GlVertexArray vao_;

@@ -18,6 +18,7 @@ layout(location = 6) uniform int hasTexture;    // 1: base colour texture on uni
 layout(location = 7) uniform int planarMirror;  // 1: this surface's reflection is drawn by a mirror pass
 layout(location = 8) uniform float shadowTexels; // side of a shadow cube face in texels
 layout(location = 9) uniform int vertexAlpha;   // 1: the vertex colour's alpha multiplies the opacity (BLEND, MASK)
+layout(location = 10) uniform int vertexColors; // 1: the scene has vertex colours (else vColor, interpolated white, is not read)
 
 layout(binding = 0) uniform sampler2D baseTexture;          // sRGB texture: sampled as linear
 layout(binding = 1) uniform samplerCubeArray shadowMaps;    // layer = light index; distance / far
@@ -46,8 +47,10 @@ void main() {
   if (!front) ns = -ns;
 
   vec4 base = baseColor;
-  base.rgb *= vColor.rgb;  // COLOR_0 (white without)
-  if (vertexAlpha != 0) base.a *= vColor.a;
+  if (vertexColors != 0) {  // COLOR_0
+    base.rgb *= vColor.rgb;
+    if (vertexAlpha != 0) base.a *= vColor.a;
+  }
   if (hasTexture != 0) base.rgb *= texture(baseTexture, vUv).rgb;
   float metal = params.x, trans = params.z;
   float diffuseWeight = (1.0 - metal) * (1.0 - trans);

@@ -1163,3 +1163,12 @@ TEST_CASE("nothing dropped in silence: what is not rendered is named in one warn
     for (const std::string& w : plain.load(dir, "plain.gltf").warnings) CHECK(w.find("not rendered") == std::string::npos);
   }
 }
+
+TEST_CASE("a negative index is named with its value") {
+  TempDir dir;
+  Gltf g;
+  g.root({{"mesh", -1}});
+  const std::string error = loadError(dir.write("negative.gltf", g.text()));
+  CHECK(error.find("nodes[0].mesh is -1; it must be a non-negative integer") != std::string::npos);
+  CHECK(error.find("but it is an integer") == std::string::npos);
+}
