@@ -1,7 +1,8 @@
 // gltf_unsupported.cpp — what a file holds that caustica does not render, named in ONE warning line
-// ("FILE: not rendered: ..."), so nothing is dropped in silence: extensions, animations, skins, morph
-// targets, vertex attributes, material textures and scenes other than the default. One entry per
-// feature below: a feature that becomes supported removes its entry here and nowhere else.
+// ("FILE: not rendered: ..."), so nothing is dropped in silence: extensions, vertex attributes,
+// material textures and scenes other than the default. One entry per feature below: a feature that
+// becomes supported removes its entry here and nowhere else (animations, skins and morph targets did:
+// gltf_animation.cpp poses them).
 #include <algorithm>
 #include <map>
 #include <set>
@@ -20,10 +21,10 @@ std::string joined(const std::set<std::string>& names) {
 }
 
 // Vertex attributes caustica reads (TANGENT where a normal map uses it; TEXCOORD_1 where a
-// material's textures name it).
+// material's textures name it; JOINTS_n and WEIGHTS_n where a skin poses the mesh).
 bool renderedAttribute(const std::string& name) {
   return name == "POSITION" || name == "NORMAL" || name == "TANGENT" || name == "TEXCOORD_0" ||
-         name == "TEXCOORD_1" || name == "COLOR_0";
+         name == "TEXCOORD_1" || name == "COLOR_0" || name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0;
 }
 
 }  // namespace
@@ -37,18 +38,7 @@ void SceneBuilder::warnNotRendered() {
   for (const std::string& ext : model_.extensionsUsed)
     if (!isSupportedExtension(ext)) extensions.insert(oneLine(ext));
   if (!extensions.empty()) entries.push_back("extension(s) " + joined(extensions));
-  // Animations: the scene is drawn as its nodes stand.
-  if (!model_.animations.empty())
-    entries.push_back("animations (" + str(model_.animations.size()) + "; the nodes are drawn as they stand)");
-  // Skins: meshes are drawn in their bind pose.
-  if (!model_.skins.empty()) entries.push_back("skins (" + str(model_.skins.size()) + "; meshes drawn in their bind pose)");
-  // Morph targets: the base shape is drawn.
-  std::set<std::string> morphed;
-  for (std::size_t m = 0; m < model_.meshes.size(); ++m)
-    for (const tinygltf::Primitive& prim : model_.meshes[m].primitives)
-      if (!prim.targets.empty()) morphed.insert("meshes[" + str(m) + "]");
-  if (!morphed.empty()) entries.push_back("morph targets of " + joined(morphed) + " (the base shape is drawn)");
-  // Vertex attributes without a meaning here (COLOR_1, TEXCOORD_2, JOINTS_0, WEIGHTS_0, _CUSTOM...).
+  // Vertex attributes without a meaning here (COLOR_1, TEXCOORD_2, _CUSTOM...).
   std::set<std::string> attributes;
   for (const tinygltf::Mesh& mesh : model_.meshes)
     for (const tinygltf::Primitive& prim : mesh.primitives)
