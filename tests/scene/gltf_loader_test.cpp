@@ -780,7 +780,7 @@ TEST_CASE("bad input files throw caustica::Error naming the file and the problem
       {"huge-accessor-count.gltf", "declared triangles to 1000000000000000, more than the limit of 16777216"},
       {"wide-node-tree.gltf", "nodes[17] (meshes[1]) brings the scene's declared triangles to 17000001"},
       {"deep-node-tree.gltf", "nodes[1023]: its world transform is not finite"},
-      // Malformed compressed data (scripts/make_wild_data.py --corrupt, from tests/data/wild/).
+      // Malformed compressed data (scripts/make-wild-data --corrupt, from tests/data/wild/).
       {"draco-truncated.glb", "KHR_draco_mesh_compression: the Draco data cannot be decoded"},
       {"draco-not-draco.glb", "KHR_draco_mesh_compression: not Draco data"},
       {"draco-count-mismatch.glb", "the Draco mesh has 4 points, but the accessor's count is 5"},
