@@ -74,7 +74,7 @@ bool pathBounce(inout PathState s) {
   Surface sf;
   if (!surfaceAt(hit, s.dir, true, sf)) return false;  // surface.glsl
   addEmission(s, sf);                                  // path_emission.glsl: with its MIS weight
-  vec4 base = materialBaseColor(sf.m, sf.uv);
+  vec4 base = materialBaseColor(sf.m, sf.uv, sf.color);
 #ifdef CAUSTICA_OPACITY
   if (passThrough(s, sf, base.a)) return true;  // path_scatter.glsl: an alpha cut-out
 #endif

@@ -10,6 +10,7 @@ struct Surface {
   vec3 ng;       // unit geometric normal on the side the ray came from
   vec3 ns;       // unit shading normal (interpolated, normal-mapped) on that side
   vec2 uv;       // texcoords
+  vec4 color;    // vertex colour (COLOR_0, linear RGBA; white without CAUSTICA_VERTEX_COLORS)
   Material m;
   float t;       // distance along the (unit) ray
   uint tri;      // the hit's triangle (TriGeom order; instanced: the stored object-space one)
@@ -71,9 +72,32 @@ bool surfaceOn(Hit hit, HitTriangle h, vec3 dir, bool normalMapped, out Surface 
   vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : sf.ngFront;
   if (dot(ns, sf.ngFront) < 0.0) ns = -ns;
   sf.uv = b0 * h.t0 + hit.u * h.t1 + hit.v * h.t2;
+  sf.color = vec4(1.0);  // exactly white where the scene has no colours (also under --all-features)
+#if defined(CAUSTICA_VERTEX_COLORS) && defined(CAUSTICA_TRISHADE_COLORS)
+  vec4 sc0, sc1, sc2;
+#ifdef CAUSTICA_INSTANCED
+  instanceColors(hit.tri, h.xf, sc0, sc1, sc2);
+#else
+  triColors(hit.tri, sc0, sc1, sc2);
+#endif
+  sf.color = b0 * sc0 + hit.u * sc1 + hit.v * sc2;
+#endif
   sf.m = materialAt(floatBitsToUint(g.v0.w));
 #ifdef CAUSTICA_TEXTURES
-  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2);
+  if (normalMapped) {
+    vec4 tangent = vec4(0.0);  // none: the normal map takes the triangle's dp/du
+#ifdef CAUSTICA_TRISHADE_TANGENTS
+    vec4 tt0, tt1, tt2;
+#ifdef CAUSTICA_INSTANCED
+    instanceTangents(hit.tri, h.xf, tt0, tt1, tt2);
+#else
+    triTangents(hit.tri, tt0, tt1, tt2);
+#endif
+    // The file's TANGENT where every corner has one (w: the first corner's sign).
+    if (tt0.w != 0.0 && tt1.w != 0.0 && tt2.w != 0.0) tangent = vec4(b0 * tt0.xyz + hit.u * tt1.xyz + hit.v * tt2.xyz, tt0.w);
+#endif
+    ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2, tangent);
+  }
 #endif
   sf.ns = sf.front ? ns : -ns;
   return true;
