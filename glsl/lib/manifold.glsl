@@ -170,7 +170,7 @@ bool traceManifoldChain(ManifoldQuery q, vec2 ab, inout ManifoldResult res, out 
     vec3 nA = normalDerivative(nd, sf.ns, pA);
     vec3 nB = normalDerivative(nd, sf.ns, pB);
     vec2 metalRough = materialMetalRough(sf.m, sf.uv);
-    vec3 color = materialBaseColor(sf.m, sf.uv).rgb;
+    vec3 color = materialBaseColor(sf.m, sf.uv, sf.color).rgb;
     bool isSmooth = metalRough.y * metalRough.y < kDeltaAlpha;
     vec3 dNew, dA, dB;
     if (refractive) {
