@@ -9,6 +9,9 @@ struct Surface {
   bool front;    // the ray arrived on the front face
   vec3 ng;       // unit geometric normal on the side the ray came from
   vec3 ns;       // unit shading normal (interpolated, normal-mapped) on that side
+#ifdef CAUSTICA_CLEARCOAT
+  vec3 nc;       // unit normal of the clear coat on that side: interpolated, with the coat's own normal map
+#endif
   vec2 uv;       // texcoords
   Material m;
   float t;       // distance along the (unit) ray
@@ -58,6 +61,14 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   if (dot(ns, sf.ngFront) < 0.0) ns = -ns;
   sf.uv = b0 * st0 + hit.u * st1 + hit.v * st2;
   sf.m = materialAt(floatBitsToUint(g.v0.w));
+#ifdef CAUSTICA_CLEARCOAT
+  vec3 nc = ns;  // KHR_materials_clearcoat: the base's normal map does not apply to the coat
+#ifdef CAUSTICA_TEXTURES
+  if (normalMapped)
+    nc = applyNormalMapTexture(sf.m.tex3.z, sf.m.coat.z, nc, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
+#endif
+  sf.nc = sf.front ? nc : -nc;
+#endif
 #ifdef CAUSTICA_TEXTURES
   if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
 #endif

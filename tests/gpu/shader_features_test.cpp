@@ -239,7 +239,8 @@ TEST_CASE("shader features: a variant compiles the rows its mode reads, its sett
   s.integrator = Integrator::Naive;  // no mis: no casters, no no-emitter variant (both need it)
   CHECK(joined(variantFeatures(everyRow(), s).defines()) ==
         "CAUSTICA_MIRROR CAUSTICA_GLASS CAUSTICA_VOLUME CAUSTICA_DISPERSION CAUSTICA_TEXTURES CAUSTICA_OPACITY "
-        "CAUSTICA_ENV CAUSTICA_PUNCTUAL CAUSTICA_SPOT_EMITTERS CAUSTICA_GGX CAUSTICA_TRANSPARENT");
+        "CAUSTICA_ENV CAUSTICA_PUNCTUAL CAUSTICA_SPOT_EMITTERS CAUSTICA_GGX CAUSTICA_CLEARCOAT CAUSTICA_SHEEN "
+        "CAUSTICA_FACTOR_TEXTURES CAUSTICA_TRANSPARENT");
 
   s = path;
   s.mode = RenderMode::Whitted;  // scene and image rows only; --all-features is the path tracer's
