@@ -417,7 +417,7 @@ std::vector<RegionEstimate> regionEstimates(const Image& a, const Image& b, cons
 // and one of the 16 may fall outside (small regions have skewed noise from rare hits: |z| up to 3.7
 // seen in 192 clean block checks).
 void checkRegionsAgree(const Scene& scene, const std::string& file, int sppNaive, int sppMis, std::uint32_t seedBase,
-                       double kSigma) {
+                       double kSigma, bool failsHalfPercent = false) {
   const double kSigmaBlock = 4.0;
   Camera cam = sceneCamera(scene);
   const int n = 32;
@@ -444,6 +444,7 @@ void checkRegionsAgree(const Scene& scene, const std::string& file, int sppNaive
                        " % = " + std::to_string(diff / se) + " standard errors";
     bool block = regions[i].name.rfind("block", 0) == 0;
     if (i == 0) MESSAGE(what, " (standard error ", 100 * se / naive[i].mean, " %)");
+    if (i == 0 && failsHalfPercent) CHECK(kSigma * se <= 0.005 * naive[i].mean);  // a 0.5 % bias of the image fails
     bool ok = std::abs(diff) <= (block ? kSigmaBlock : kSigma) * se;
     if (block) {
       if (!ok) {
@@ -654,4 +655,143 @@ TEST_CASE("normal maps and KHR_texture_transform change the shading normal as th
   CHECK(plain > 0.01);
   CHECK(flat / plain == Rel(1.0, 1e-4));
   CHECK(tilted / plain == Rel(0.4982, 0.01));
+}
+
+namespace {
+
+// A white Lambertian sphere (radius 1, at the origin) under the given layers, inside a black sphere that
+// emits radiance 1 everywhere, seen whole from 3.2 units away (every angle to the sphere's normal, and
+// the enclosure around it): the white furnace of a material.
+Scene layeredFurnace(float coat, float coatRoughness, glm::vec3 sheenColor, float sheenRoughness) {
+  Scene s;
+  Material m = diffuseMaterial(1.0f);
+  m.clearcoat = coat;
+  m.clearcoatRoughness = coatRoughness;
+  m.sheenColor = sheenColor;
+  m.sheenRoughness = sheenRoughness;
+  Material sky = emitterMaterial(1.0f);
+  sky.doubleSided = true;
+  s.materials = {m, sky};
+  addSphere(s, {0, 0, 0}, 1.0f, 48, 0);
+  addSphere(s, {0, 0, 0}, 6.0f, 12, 1);
+  finishBounds(s);
+  s.cameras.push_back(lookAt({0.0f, 0.0f, 3.2f}, glm::vec3(0.0f), 0.75f));
+  return s;
+}
+
+// Mean and standard error of the pixels' grey values (independent estimates) of an image.
+std::pair<double, double> pixelMean(const Image& img) {
+  std::vector<double> grey;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) grey.push_back((img.at(x, y, 0) + img.at(x, y, 1) + img.at(x, y, 2)) / 3);
+  double mean = 0, var = 0;
+  for (double g : grey) mean += g / double(grey.size());
+  for (double g : grey) var += (g - mean) * (g - mean) / (double(grey.size()) - 1.0);
+  return {mean, std::sqrt(var / double(grey.size()))};
+}
+
+}  // namespace
+
+// The layers' white furnace on the GPU: a white base under a smooth clear coat keeps exactly what the
+// coat does not reflect, so every pixel is 1 (each naive sample is 1 to rounding: the coat's pick over a
+// white base is its weight); under a white sheen the layer takes max(sheenColor) E(cos_o) and gives back
+// as much (1 to the albedo table's accuracy: 2e-4 on average); a rough coat loses GGX's single-scattering
+// deficit on its share (below 1, never above). The tolerance is 4.5 standard errors of the image mean (its
+// independent pixels), asserted to fail a 0.5 % bias. Measured: see the MESSAGEs (docs/materials.md).
+TEST_CASE("furnace: clear coat and sheen over a white base give back what they take") {
+  struct Case {
+    const char* name;
+    float coat, coatRoughness;
+    glm::vec3 sheen;
+    float sheenRoughness;
+    bool exact;  // 1 in every pixel; else at most 1
+  };
+  const Case cases[] = {{"smooth clear coat", 1.0f, 0.0f, glm::vec3(0.0f), 0.0f, true},
+                        {"white sheen, roughness 0.3", 0.0f, 0.0f, glm::vec3(1.0f), 0.3f, true},
+                        {"white sheen, roughness 0.8, under a smooth coat", 1.0f, 0.0f, glm::vec3(1.0f), 0.8f, true},
+                        {"rough clear coat (0.5)", 1.0f, 0.5f, glm::vec3(0.0f), 0.0f, false}};
+  for (const Case& c : cases) {
+    const Scene s = layeredFurnace(c.coat, c.coatRoughness, c.sheen, c.sheenRoughness);
+    for (Integrator integ : {Integrator::Naive, Integrator::Mis}) {
+      const int n = 40;
+      RenderResult r = renderScene(s, s.cameras[0], smallSettings(n, n, integ, 7), 128, 64);
+      CHECK(hasDefine(r.defines, c.coat > 0.0f ? "CAUSTICA_CLEARCOAT" : "CAUSTICA_SHEEN"));
+      const auto [mean, se] = pixelMean(r.image);
+      double hi = 0.0;
+      for (float v : r.image.rgb) hi = std::max(hi, double(v));
+      const std::string what = std::string(c.name) + " " + integratorName(integ) + ": image mean " +
+                               std::to_string(mean) + ", standard error " + std::to_string(100 * se) + " %, brightest " +
+                               std::to_string(hi);
+      MESSAGE("layered furnace ", what);
+      INFO(what);
+      if (c.exact) CHECK(std::abs(mean - 1.0) <= 4.5 * se + 2e-4);
+      else CHECK(mean <= 1.0 + 4.5 * se);
+      CHECK(4.5 * se <= 0.005);
+      if (c.exact && integ == Integrator::Naive && c.sheen == glm::vec3(0.0f)) CHECK(hi < 1.0 + 1e-4);  // each sample 1
+      CHECK(r.stats.nonFinite == 0);
+    }
+  }
+}
+
+// One layered material filling the view under a square light, at depth 2 (direct light only): the coat's
+// and the sheen's light sampling (vertexEval, vertexPdf about the coat's own normal) against pure BSDF
+// sampling, per region; the whole image must be sharp enough to fail a 0.5 % bias. The last case lights a
+// white floor with an unlit, cut-out (alpha MASK) quad under a clear coat: emission only where the quad is
+// present and darkened by its coat, alike in both estimators.
+TEST_CASE("naive and mis agree per region: clear coat, sheen and an unlit cut-out light") {
+  for (int kind = 0; kind < 5; ++kind) {
+    Scene s;
+    Material m = diffuseMaterial(glm::vec3(0.6f, 0.05f, 0.04f));
+    m.roughness = 0.4f;
+    m.specularF0 = glm::vec3(0.04f);
+    m.specularF90 = 1.0f;
+    Material light = emitterMaterial(4.0f);
+    const char* names[] = {"red plastic under a smooth clear coat", "red plastic under a rough coat (0.3, weight 0.7)",
+                           "velvet: sheen (0.9, 0.6, 0.3) roughness 0.3 over dark red", "sheen under a coat, coated light",
+                           "white floor under an unlit coated cut-out light"};
+    if (kind == 1) {
+      m.clearcoat = 0.7f;
+      m.clearcoatRoughness = 0.3f;
+    } else if (kind == 0) {
+      m.clearcoat = 1.0f;
+    }
+    if (kind == 2 || kind == 3) {
+      m.baseColor = glm::vec4(0.15f, 0.02f, 0.02f, 1.0f);
+      m.sheenColor = glm::vec3(0.9f, 0.6f, 0.3f);
+      m.sheenRoughness = 0.3f;
+    }
+    if (kind == 3) {
+      m.clearcoat = 0.5f;
+      m.clearcoatRoughness = 0.2f;
+      light.clearcoat = 1.0f;
+    }
+    if (kind == 4) {
+      m = diffuseMaterial(0.8f);
+      light.emission = glm::vec3(3.0f, 2.0f, 1.0f);  // an unlit surface: its colour emitted, nothing reflected
+      light.unlit = true;
+      light.clearcoat = 1.0f;
+      light.alphaFromTexture = true;
+      light.alphaCutoff = 0.5f;
+      light.baseColorTexture = 0;  // a 2 x 2 checker of alpha: half of the quad is cut out
+      Texture t;
+      t.width = t.height = 2;
+      t.rgba = {255, 255, 255, 255, 255, 255, 255, 0, 255, 255, 255, 0, 255, 255, 255, 255};
+      t.nearest = true;
+      s.textures.push_back(t);
+    }
+    s.materials = {m, light};
+    addQuad(s, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, 0);  // facing +y
+    const float h = 1.0f;  // a large light: the naive estimate's noise is what limits the test
+    addQuad(s, {-h, 1.0f, -h}, {h, 1.0f, -h}, {h, 1.0f, h}, {-h, 1.0f, h}, 1);  // facing -y
+    if (kind == 4) {  // the checker over the light quad: u along x, v along z
+      s.texcoords.assign(s.triangles.size(), TriangleUv{});
+      const glm::vec2 uv[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+      s.texcoords[2].uv[0] = uv[0], s.texcoords[2].uv[1] = uv[1], s.texcoords[2].uv[2] = uv[2];
+      s.texcoords[3].uv[0] = uv[0], s.texcoords[3].uv[1] = uv[2], s.texcoords[3].uv[2] = uv[3];
+    }
+    finishBounds(s);
+    s.cameras.push_back(lookAt({0.0f, 1.6f, 1.6f}, {0.0f, 0.0f, -0.3f}, 0.9f));
+    const int spp = kind == 4 ? 2 : 1;  // the cut-out light's naive estimate is the noisiest
+    checkRegionsAgree(s, names[kind], 4096 * spp, 2048 * spp, 1000 + 10 * kind, 4.0, true);
+  }
 }
