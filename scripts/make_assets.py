@@ -443,9 +443,12 @@ class Gltf:
 
     def material(self, name, color=(0.8, 0.8, 0.8), alpha=1.0, metallic=0.0, roughness=1.0,
                  emissive=None, strength=1.0, transmission=0.0, ior=None, thickness=None,
-                 dispersion=None, double_sided=False, base_texture=None, specular=0.0):
+                 dispersion=None, double_sided=False, base_texture=None, specular=0.0, clearcoat=None,
+                 sheen=None, unlit=False):
         """specular: KHR_materials_specular's specularFactor of the dielectric layer over the diffuse
-        base. The shipped Cornell scenes are Lambertian (0, written out); glTF's default is 1."""
+        base. The shipped Cornell scenes are Lambertian (0, written out); glTF's default is 1.
+        clearcoat: (clearcoatFactor, clearcoatRoughnessFactor); sheen: (sheenColorFactor,
+        sheenRoughnessFactor); unlit: KHR_materials_unlit."""
         pbr = {"baseColorFactor": [clean(c) for c in color] + [clean(alpha)],
                "metallicFactor": clean(metallic), "roughnessFactor": clean(roughness)}
         if base_texture is not None:
@@ -468,6 +471,14 @@ class Gltf:
             ext["KHR_materials_dispersion"] = {"dispersion": clean(dispersion)}
         if specular != 1.0 and metallic < 1.0 and transmission < 1.0:
             ext["KHR_materials_specular"] = {"specularFactor": clean(specular)}
+        if clearcoat is not None:
+            ext["KHR_materials_clearcoat"] = {"clearcoatFactor": clean(clearcoat[0]),
+                                              "clearcoatRoughnessFactor": clean(clearcoat[1])}
+        if sheen is not None:
+            ext["KHR_materials_sheen"] = {"sheenColorFactor": [clean(c) for c in sheen[0]],
+                                          "sheenRoughnessFactor": clean(sheen[1])}
+        if unlit:
+            ext["KHR_materials_unlit"] = {}
         if ext:
             mat["extensions"] = ext
             self.extensions.update(ext.keys())
@@ -602,6 +613,48 @@ def cornell_materials(segments=48, rings=24):
                                      ("plastic sphere", plastic, (0.5, radius, -0.2)),
                                      ("frosted sphere", frosted, (0.0, radius, 0.35))):
         g.node(name, mesh=g.mesh(name, [dict(prim, material=material)]), translation=position)
+    g.camera("camera", **CORNELL_CAMERA)
+    return g.finish()
+
+
+def stripes_png():
+    """64x64 poster for an unlit panel: four horizontal bands (sRGB) of saturated colours over a light grey."""
+    bands = [(200, 60, 40), (240, 190, 60), (60, 150, 90), (50, 90, 180)]
+
+    def pixel(x, y):
+        if 8 <= y < 56 and 6 <= x < 58:
+            return bands[(y - 8) // 12]
+        return (225, 225, 220)
+    return png_bytes(64, 64, pixel)
+
+
+def cornell_layers(segments=48, rings=24):
+    """The layers glTF puts over its materials, in the classic box: a red plastic sphere under a smooth
+    clear coat (car paint), a deep red velvet sphere (sheen over a dark diffuse base), a black sphere
+    that is nothing but a clear coat (its reflections alone), and an unlit poster on the back wall
+    (KHR_materials_unlit: it shows its texture as stored, whatever the light)."""
+    g = Gltf()
+    add_cornell_box(g)
+    add_ceiling_light(g, 0.47, 0.38)
+    radius = 0.3
+    paint = g.material("coated red paint", color=(0.6, 0.04, 0.03), roughness=0.5, specular=1.0,
+                       clearcoat=(1.0, 0.0))
+    velvet = g.material("red velvet", color=(0.25, 0.02, 0.04), roughness=1.0, specular=1.0,
+                        sheen=((1.0, 0.45, 0.55), 0.35))
+    black = g.material("black coat", color=(0.0, 0.0, 0.0), roughness=1.0, specular=0.0, clearcoat=(1.0, 0.0))
+    prim = g.primitive(uv_sphere(radius, segments, rings), paint)
+    for name, material, position, scale in (("coated sphere", paint, (-0.45, radius, -0.35), 1.0),
+                                            ("velvet sphere", velvet, (0.45, radius, -0.2), 1.0),
+                                            ("black coated sphere", black, (-0.05, 0.2, 0.4), 2.0 / 3.0)):
+        g.node(name, mesh=g.mesh(name, [dict(prim, material=material)]), translation=position,
+               scale_=(scale, scale, scale))
+    poster = g.texture_png(stripes_png(), {"magFilter": LINEAR, "minFilter": LINEAR, "wrapS": REPEAT,
+                                           "wrapT": REPEAT})
+    unlit = g.material("unlit poster", color=(1.0, 1.0, 1.0), base_texture=poster, unlit=True)
+    panel = MeshData(with_uvs=True)
+    panel.polygon([(0.15, 1.55, -0.99), (0.75, 1.55, -0.99), (0.75, 0.95, -0.99), (0.15, 0.95, -0.99)], (0, 0, 1),
+                  [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)])
+    g.object("unlit poster", panel, unlit)
     g.camera("camera", **CORNELL_CAMERA)
     return g.finish()
 
@@ -1098,6 +1151,7 @@ def main():
         os.path.join(SCENES, "punctual-lights.gltf"): punctual_lights_scene(),
         os.path.join(SCENES, "many-lights.gltf"): many_lights_scene(),
         os.path.join(SCENES, "cornell-materials.gltf"): cornell_materials(),
+        os.path.join(SCENES, "cornell-layers.gltf"): cornell_layers(),
         os.path.join(SCENES, "mirror-caustic.gltf"): mirror_caustic(),
         os.path.join(TEST_SCENES, "furnace.gltf"): furnace(),
         os.path.join(TEST_SCENES, "furnace-glass.gltf"): furnace(glass=True),

@@ -170,7 +170,7 @@ TEST_CASE("every shipped scene loads with triangles, lights, a camera and consis
                          "assets/scenes/cornell-bunny-light.gltf",  "assets/scenes/cornell-textured.gltf",
                          "assets/scenes/cornell-dispersion.gltf",   "tests/data/scenes/furnace.gltf",
                          "tests/data/scenes/furnace-glass.gltf",    "tests/data/scenes/glass-in-white-enclosure.gltf",
-                         "tests/data/scenes/small-cornell.gltf"};
+                         "tests/data/scenes/small-cornell.gltf",    "assets/scenes/cornell-layers.gltf"};
   for (const std::string file : files) {
     CAPTURE(file);
     const Scene s = caustica::loadScene(source(file));
