@@ -1,4 +1,4 @@
-// main.cpp — the caustica command line: render / info / view / bench / compare subcommands.
+// main.cpp — the caustica command line: render / info / view / bench / compare / merge subcommands.
 // Setup errors are exceptions, caught here once and printed as one line with a non-zero exit.
 #include <cstring>
 #include <iostream>
@@ -22,6 +22,7 @@ const char* kUsage =
     "  info SCENE       print what a scene holds and what the renderer will need for it\n"
     "  bench [SCENE..]  measure run time against error for each estimator\n"
     "  compare [SCENE]  raster, Whitted and path tracing side by side with the table of effects\n"
+    "  merge PART...    add the partials of a render's shards (render --shard K/N) into its image\n"
     "\n"
     "SCENE is a .gltf/.glb file or the name of a bundled scene (default: cornell-glass).\n"
     "'caustica <command> --help' describes each command's options.\n";
@@ -46,7 +47,8 @@ int main(int argc, char** argv) {
     if (command == "view") return caustica::cli::cmdView(args);
     if (command == "bench") return caustica::cli::cmdBench(args);
     if (command == "compare") return caustica::cli::cmdCompare(args);
-    std::cerr << "caustica: unknown command '" << command << "' (commands: render, view, info, bench, compare; see --help)\n";
+    if (command == "merge") return caustica::cli::cmdMerge(args);
+    std::cerr << "caustica: unknown command '" << command << "' (commands: render, view, info, bench, compare, merge; see --help)\n";
     return 2;
   } catch (const caustica::Error& e) {
     std::string msg = e.what();

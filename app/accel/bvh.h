@@ -13,7 +13,7 @@ namespace caustica {
 struct BvhBuildOptions {
   int bins = 16;            // SAH bins per axis
   // Meshes of fewer than secondBinsBelow triangles are also built with secondBins bins (0: not), and the
-  // tree of lower SAH cost is kept (costs ~1 ms per 4,000 triangles; docs/benchmarks.md, "Session 7").
+  // tree of lower SAH cost is kept (costs ~1 ms per 4,000 triangles; docs/architecture.md, "BVH build").
   int secondBins = 32;
   std::size_t secondBinsBelow = 65536;
   int maxLeafSize = 4;      // leaves never hold more triangles than this (at most gpu::kBvhMaxLeafSize)

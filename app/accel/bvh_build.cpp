@@ -257,7 +257,7 @@ Bvh buildBvhOnce(const Triangle* triangles, std::size_t count, const BvhBuildOpt
 Bvh buildBvh(const Triangle* triangles, std::size_t count, const BvhBuildOptions& options) {
   Bvh bvh = buildBvhOnce(triangles, count, options);
   // Small meshes: a second build with other bins, kept when its SAH cost is lower (binned SAH splits
-  // greedily top-down, so more bins can make a worse tree: docs/benchmarks.md, "Session 7").
+  // greedily top-down, so more bins can make a worse tree: docs/architecture.md, "BVH build").
   if (options.secondBins > 0 && options.secondBins != options.bins && count < options.secondBinsBelow) {
     BvhBuildOptions o = options;
     o.bins = options.secondBins;

@@ -277,7 +277,7 @@ int visitWide(const gpu::BvhWideNode& n, const glm::vec3& org, const glm::vec3& 
 
 // Shared by closest and any hit, in the GLSL twin's order: the nearest entered child next, the others
 // stacked nearest on top (refs only, as the twin: a popped subtree beyond the closest hit is entered and
-// its node visit or leaf test finds nothing nearer, docs/benchmarks.md "Session 5"). The GLSL keeps the
+// its node visit or leaf test finds nothing nearer; docs/architecture.md, "Traversal"). The GLSL keeps the
 // stack's top eight refs in registers and the rest in an array, one LIFO stack all the same.
 template <bool kAnyHit>
 Hit traverseWide(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriGeom>& tris, const Ray& ray,

@@ -12,11 +12,11 @@
 
 namespace caustica {
 
-// How packBvhWideNodes shapes the wide tree (docs/architecture.md, "the collapse"; measured in
-// docs/benchmarks.md, "Session 7: the tree's shape").
+// How packBvhWideNodes shapes the wide tree (docs/architecture.md, "The 4-wide tree", which says what
+// was measured and how).
 struct WideCollapseOptions {
   enum class Method {
-    Greedy,  // open the inner child of largest surface area until four children (session 4)
+    Greedy,  // open the inner child of largest surface area until four children
     Sah,     // dynamic programme over the binary tree minimising the SAH cost below (Ylitie et al. 2017 style)
   };
   Method method = Method::Sah;

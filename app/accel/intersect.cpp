@@ -70,7 +70,7 @@ bool intersectTriangleSheared(const glm::vec3& origin, const RayShear& rs, const
   const float det = e0 + e1 + e2;
   if (det == 0.0f) return false;  // ray in the triangle's plane
   // Zero-area triangles can pass the test above once their vertices are rounded in ray space (in a
-  // scratch search the t error bound below then rejected every one, docs/benchmarks.md "Session 7",
+  // scratch search the t error bound below then rejected every one, docs/architecture.md "Traversal",
   // but that is not proven). The GLSL twin has no such check: packedTrianglePositions stores them as
   // one point, which det == 0 rejects; this check keeps the reference right for any vertices.
   if (isZeroAreaTriangle(p0, p1, p2)) return false;

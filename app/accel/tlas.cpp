@@ -99,27 +99,43 @@ InstancedHit traverse(const InstancedBvh& bvh, const Ray& ray, float tmax) {
 
 }  // namespace
 
-InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& options) {
+MeshBvhs buildMeshBvhs(const Scene& scene, const BvhBuildOptions& options) {
   if (scene.instances.empty()) throw Error("tlas.cpp: the scene has no instances (load it with keepInstances)");
-  InstancedBvh out;
-  // Bottom level: one tree per mesh, appended after the top level's nodes (rebased at the end).
-  std::vector<std::vector<gpu::BvhNode>> meshNodes(scene.meshes.size());
-  std::vector<std::uint32_t> triOffset(scene.meshes.size());
-  std::vector<glm::vec3> meshMin(scene.meshes.size()), meshMax(scene.meshes.size());
-  int meshDepth = 0;
+  MeshBvhs out;
+  out.nodes.resize(scene.meshes.size());
+  out.triOffset.resize(scene.meshes.size());
+  out.boundsMin.resize(scene.meshes.size());
+  out.boundsMax.resize(scene.meshes.size());
   out.tris.reserve(scene.triangles.size());  // every stored triangle once
   out.triSource.reserve(scene.triangles.size());
   for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
     const MeshRange& range = scene.meshes[m];
     const Triangle* tris = scene.triangles.data() + range.firstTriangle;  // the mesh's range, not a copy
     Bvh b = buildBvh(tris, range.triangleCount, options);
-    meshDepth = std::max(meshDepth, b.depth);
-    triOffset[m] = std::uint32_t(out.tris.size());
+    out.depth = std::max(out.depth, b.depth);
+    out.triOffset[m] = std::uint32_t(out.tris.size());
     appendTriGeom(tris, range.triangleCount, b, out.tris);
     for (std::uint32_t o : b.order) out.triSource.push_back(range.firstTriangle + o);
-    if (!bvhBounds(b.nodes, meshMin[m], meshMax[m])) meshMin[m] = meshMax[m] = glm::vec3(0.0f);
-    meshNodes[m] = std::move(b.nodes);
+    if (!bvhBounds(b.nodes, out.boundsMin[m], out.boundsMax[m])) out.boundsMin[m] = out.boundsMax[m] = glm::vec3(0.0f);
+    out.nodes[m] = std::move(b.nodes);
   }
+  return out;
+}
+
+InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& options) {
+  return placeInstances(scene, buildMeshBvhs(scene, options), options);
+}
+
+InstancedBvh placeInstances(const Scene& scene, const MeshBvhs& meshes, const BvhBuildOptions& options) {
+  return placeInstances(scene, MeshBvhs(meshes), options);
+}
+
+InstancedBvh placeInstances(const Scene& scene, MeshBvhs&& meshes, const BvhBuildOptions& options) {
+  if (scene.instances.empty()) throw Error("tlas.cpp: the scene has no instances (load it with keepInstances)");
+  if (meshes.nodes.size() != scene.meshes.size()) throw Error("internal: placeInstances with another scene's meshes");
+  InstancedBvh out;
+  out.tris = std::move(meshes.tris);
+  out.triSource = std::move(meshes.triSource);
   // Top level: each instance's world box (its mesh box's corners moved), as a degenerate "triangle"
   // spanning the box with its centre as centroid; leaves of one instance.
   std::vector<Triangle> boxes(scene.instances.size());
@@ -132,8 +148,8 @@ InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& option
     worldToObject[i] = glm::inverse(world);
     Bounds b;
     for (int c = 0; c < 8; ++c) {
-      const glm::vec3& lo = meshMin[in.mesh];
-      const glm::vec3& hi = meshMax[in.mesh];
+      const glm::vec3& lo = meshes.boundsMin[in.mesh];
+      const glm::vec3& hi = meshes.boundsMax[in.mesh];
       const glm::dvec4 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z, 1.0);
       b.grow(glm::vec3(glm::dvec3(world * p)));
     }
@@ -144,7 +160,7 @@ InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& option
   BvhBuildOptions top = options;
   top.maxLeafSize = 1;
   Bvh tlas = buildBvh(boxes, top);
-  out.depth = tlas.depth + meshDepth;
+  out.depth = tlas.depth + meshes.depth;
   if (out.depth >= kStack) throw Error("tlas.cpp: two-level BVH depth " + std::to_string(out.depth) + " exceeds the stack");
   out.topNodeCount = std::uint32_t(tlas.nodes.size());
   out.nodes = std::move(tlas.nodes);
@@ -164,12 +180,12 @@ InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& option
   for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
     const std::uint32_t nodeOffset = std::uint32_t(out.nodes.size());
     out.meshRoot[m] = nodeOffset;
-    for (gpu::BvhNode n : meshNodes[m]) {
-      n.left = rebase(n.left, nodeOffset, triOffset[m]);
-      n.right = rebase(n.right, nodeOffset, triOffset[m]);
+    for (gpu::BvhNode n : meshes.nodes[m]) {
+      n.left = rebase(n.left, nodeOffset, meshes.triOffset[m]);
+      n.right = rebase(n.right, nodeOffset, meshes.triOffset[m]);
       out.nodes.push_back(n);
     }
-    std::vector<gpu::BvhNode>().swap(meshNodes[m]);
+    std::vector<gpu::BvhNode>().swap(meshes.nodes[m]);
   }
   for (gpu::InstanceRecord& r : out.instances) r.root = out.meshRoot[r.mesh];
   return out;

@@ -27,8 +27,26 @@ struct InstancedBvh {
 };
 
 // Builds from a scene with instances (throws caustica::Error for one without). Instances are placed
-// with the float world-to-object matrix of (Scene::origin-rebased) Instance::world.
+// with the float world-to-object matrix of (Scene::origin-rebased) Instance::world. The same as
+// placeInstances(scene, buildMeshBvhs(scene, options), options).
 InstancedBvh buildInstancedBvh(const Scene& scene, const BvhBuildOptions& options = {});
+
+// The bottom level alone: one BVH per mesh of Scene::meshes, over its object-space triangles. It does
+// not depend on the instances, so a rigid animation keeps it from frame to frame and only re-places
+// the instances (Renderer::setScene; docs/animation.md).
+struct MeshBvhs {
+  std::vector<std::vector<gpu::BvhNode>> nodes;  // per mesh, refs local to the mesh
+  std::vector<std::uint32_t> triOffset;         // per mesh: its first record in `tris`
+  std::vector<gpu::TriGeom> tris;               // object space, each mesh in its own leaf order
+  std::vector<std::uint32_t> triSource;         // tris index -> Scene::triangles index
+  std::vector<glm::vec3> boundsMin, boundsMax;  // per mesh
+  int depth = 0;                                // deepest mesh tree
+};
+MeshBvhs buildMeshBvhs(const Scene& scene, const BvhBuildOptions& options = {});
+// The top level over `scene`'s instances of meshes built by buildMeshBvhs: copied (kept for the next
+// frame) or moved (no second copy of the meshes' records).
+InstancedBvh placeInstances(const Scene& scene, const MeshBvhs& meshes, const BvhBuildOptions& options = {});
+InstancedBvh placeInstances(const Scene& scene, MeshBvhs&& meshes, const BvhBuildOptions& options = {});
 
 struct InstancedHit {
   Hit hit;                                         // t in world units of the ray's dir; hit.tri indexes tris

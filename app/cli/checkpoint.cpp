@@ -50,8 +50,11 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     << "spp " << st.spp << '\n'
     << "sample-base " << st.sampleBase << '\n'
     << "coverage " << (st.coverage.empty() ? 0 : 1) << '\n'
-    << "seed " << ck.seed << '\n'
-    << "scene " << hex64(ck.sceneHash) << '\n'
+    << "seed " << ck.seed << '\n';
+  if (ck.shard)
+    h << "shard " << ck.shard->index << '/' << ck.shard->count << ' ' << ck.shard->first << ' ' << ck.shard->end << ' '
+      << ck.shard->total << '\n';
+  h << "scene " << hex64(ck.sceneHash) << '\n'
     << "data " << hex64(dataHash(st)) << '\n'
     << "settings " << ck.identity.size() << '\n'
     << ck.identity << "end\n";
@@ -91,8 +94,8 @@ Checkpoint readCheckpoint(const std::string& path) {
   };
   const unsigned long long version = num(kCheckpointMagic);
   if (version < kCheckpointOldestVersion || version > kCheckpointVersion)
-    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads version " +
-              std::to_string(kCheckpointVersion) +
+    throw bad("version " + head[kCheckpointMagic] + " (this caustica reads versions " +
+              std::to_string(kCheckpointOldestVersion) + " to " + std::to_string(kCheckpointVersion) +
               (version < kCheckpointOldestVersion ? ", whose settings name every option that changes the image; "
                                                     "render again to write one"
                                                   : "") +
@@ -110,6 +113,22 @@ Checkpoint readCheckpoint(const std::string& path) {
   st.sampleBase = static_cast<std::uint32_t>(num("sample-base"));
   ck.seed = static_cast<std::uint32_t>(num("seed"));
   ck.sceneHash = num("scene");
+  if (auto it = head.find("shard"); it != head.end()) {
+    SampleShare sh;
+    char slash = 0;
+    std::istringstream line(it->second);
+    long long k = 0, n = 0, first = 0, last = 0, total = 0;
+    std::string rest;
+    if (!(line >> k >> slash >> n >> first >> last >> total) || slash != '/' || (line >> rest) || k < 1 || k > n ||
+        n > (1 << 30) || first < 0 || first > last || last > total || total > (1ll << 31))
+      throw bad("bad shard line '" + it->second + "'");
+    sh.index = int(k);
+    sh.count = int(n);
+    sh.first = std::uint32_t(first);
+    sh.end = std::uint32_t(last);
+    sh.total = std::uint32_t(total);
+    ck.shard = sh;
+  }
   const std::uint64_t expected = num("data");
   if (settingsLineEnd + 1 + settingsBytes != end + 1) throw bad("settings text of the wrong length");
   ck.identity = bytes.substr(settingsLineEnd + 1, settingsBytes);

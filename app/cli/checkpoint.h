@@ -9,6 +9,7 @@
 // identityDifference for the settings alone.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "cli/image_settings.h"
@@ -23,14 +24,29 @@ constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
 // (--background transparent).
 // 4: the settings text is the accumulation identity (every Accumulation field of ImageSettings, one
 // "key value" a line); older files are refused, naming the file: their settings text lacks fields.
-constexpr int kCheckpointVersion = 4;
+// 5: adds an optional "shard K/N FIRST END TOTAL" line: the file is the partial of a shard (render
+// --shard, cli/shard.h). Version 4 files read as version 5 files without it.
+constexpr int kCheckpointVersion = 5;
 constexpr int kCheckpointOldestVersion = 4;
+
+// The share of one shard of a render (render --shard K/N): the global sample indices [first, end) of a
+// render of `total` samples per pixel. A shard's partial holds [first, AccumulationState::sampleBase).
+struct SampleShare {
+  int index = 0, count = 0;  // K and N of --shard K/N (1 <= K <= N)
+  std::uint32_t first = 0, end = 0, total = 0;
+  bool operator==(const SampleShare& o) const {
+    return index == o.index && count == o.count && first == o.first && end == o.end && total == o.total;
+  }
+  bool operator!=(const SampleShare& o) const { return !(*this == o); }
+};
 
 struct Checkpoint {
   AccumulationState state;        // the three rgba32f images (+ coverage), spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
   std::string identity;           // accumulationIdentity(settings, camera) of the render
+  // Set in a shard's partial (mergeable with `caustica merge`); unset in a whole render's checkpoint.
+  std::optional<SampleShare> shard;
 };
 
 // Writes `path` atomically: a temporary file in the same folder (path + ".tmp"), fsync, rename. An

@@ -137,8 +137,72 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--quiet", "-q", "", "print nothing but errors"},
   };
   for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
+  for (OptionSpec& s : animationOptionSpecs()) specs.push_back(std::move(s));
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   return specs;
+}
+
+std::vector<OptionSpec> animationOptionSpecs() {
+  return {
+      {"--anim-time", "", "SECONDS", "pose the scene's glTF animation at this time (default 0; docs/animation.md)"},
+      {"--frame", "", "N", "pose it at frame N of --fps frames a second (time N / F)"},
+      {"--fps", "", "F", "frames a second for --frame and --frames (default 24)"},
+      {"--animation", "", "NAME|INDEX",
+       "which of the file's animations plays: its name or index, or all (default: all when no two animate the "
+       "same node property, else the first)"},
+  };
+}
+
+bool animationTimeGiven(const Options& opts) {
+  return opts.has("--anim-time") || opts.has("--frame") || opts.has("--frames");
+}
+
+ScenePose scenePoseFrom(const Options& opts) {
+  ScenePose pose;
+  pose.animation = opts.get("--animation", "");
+  if (opts.has("--animation") && pose.animation.empty()) throw Error("option --animation needs a name, an index or all");
+  if (pose.animation == "first") pose.animation.clear();
+  const double fps = opts.getDouble("--fps", 24.0);
+  if (!(fps > 0.0 && fps <= 1e6)) throw Error("option --fps needs a number of frames a second above 0");
+  if (opts.has("--fps") && !opts.has("--frame") && !opts.has("--frames"))
+    throw Error("option --fps needs --frame N (or render's --frames A..B)");
+  if (opts.has("--anim-time") && (opts.has("--frame") || opts.has("--frames")))
+    throw Error("give the time with --anim-time or with --frame/--frames, not both");
+  if (opts.has("--anim-time")) {
+    pose.time = opts.getDouble("--anim-time", 0.0);
+    if (!(std::abs(pose.time) < 1e9)) throw Error("option --anim-time needs a finite number of seconds");
+  } else if (opts.has("--frame")) {
+    pose.time = double(opts.getInt("--frame", 0, 0, 1 << 30)) / fps;
+  }
+  return pose;
+}
+
+std::string animationsSummary(const Scene& s) {
+  if (s.animations.empty()) return "none";
+  auto seconds = [](double t) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4g", t);
+    return std::string(b);
+  };
+  std::string out = std::to_string(s.animations.size()) + (s.animations.size() == 1 ? " animation: " : " animations: ");
+  constexpr std::size_t kListed = 4;  // files with one animation per node have dozens
+  for (std::size_t i = 0; i < s.animations.size(); ++i) {
+    if (i == kListed) {
+      out += ", ... (" + std::to_string(s.animations.size() - kListed) + " more)";
+      break;
+    }
+    const AnimationInfo& a = s.animations[i];
+    out += (i ? ", " : "") + std::to_string(i) + (a.name.empty() ? "" : " '" + a.name + "'") + " " + seconds(a.start) +
+           "-" + seconds(a.end) + " s (" + std::to_string(a.channels) + (a.channels == 1 ? " channel" : " channels") +
+           (a.weights ? ", morph weights" : "") + (a.skins ? ", skin joints" : "") + ")";
+  }
+  std::string played;
+  if (s.animationsPlayed.size() > 1 && s.animationsPlayed.size() == s.animations.size()) played = "all";
+  else
+    for (int i : s.animationsPlayed)
+      played += (played.empty() ? "" : " and ") + std::to_string(i) +
+                (s.animations[std::size_t(i)].name.empty() ? "" : " '" + s.animations[std::size_t(i)].name + "'");
+  return out + "; showing " + (played.empty() ? "none" : played) + " at t = " + seconds(s.animationTime) + " s";
 }
 
 std::vector<OptionSpec> sceneInputOptionSpecs() {
@@ -292,11 +356,23 @@ int cameraIndexFrom(const Options& opts) { return opts.getInt("--camera", 0, 0, 
 
 LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose, int defaultWidth) {
   const LoadOptions loadOptions = loadOptionsFrom(opts);  // option errors before any file is read
+  const ScenePose pose = scenePoseFrom(opts);
   std::string path = resolveScenePath(nameOrPath);
-  LoadedScene ls;
-  ls.scene = loadScene(path, loadOptions);
+  Scene scene = loadScene(path, loadOptions, pose);
   releaseFreedMemory();  // the parser's arrays and the file's bytes: freed heap back to the kernel (memory_stats.h)
-  for (const auto& w : ls.scene.warnings) note(!verbose, "warning: " + w);
+  for (const auto& w : scene.warnings) note(!verbose, "warning: " + w);
+  if (!scene.animations.empty() && !animationTimeGiven(opts))
+    note(!verbose, path + " has " + animationsSummary(scene) +
+                       " (choose the time with --anim-time SECONDS or --frame N --fps F, the animation with --animation)");
+  else if (scene.animations.empty() && animationTimeGiven(opts))
+    note(!verbose, "warning: " + path + " has no animations: the time given changes nothing");
+  return prepareLoadedScene(std::move(scene), opts, pose, verbose, defaultWidth);
+}
+
+LoadedScene prepareLoadedScene(Scene scene, const Options& opts, const ScenePose& pose, bool verbose, int defaultWidth) {
+  LoadedScene ls;
+  ls.scene = std::move(scene);
+  const std::string& path = ls.scene.path;
   int index = cameraIndexFrom(opts);
   if (ls.scene.cameras.empty()) {
     if (opts.has("--camera")) throw Error(path + ": the scene has no camera, --camera cannot pick one");
@@ -308,6 +384,11 @@ LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, 
     ls.camera = ls.scene.cameras[static_cast<size_t>(index)];
   }
   ls.settings = imageSettingsFrom(opts, ls.camera, defaultWidth);
+  // The pose the scene was built with is part of the image (accumulation identity); a file without
+  // animations looks the same at any time, so its identity keeps the defaults.
+  const SceneSettings unposed;
+  ls.settings.scene.animation = ls.scene.animations.empty() ? unposed.animation : pose.animation.empty() ? "first" : pose.animation;
+  ls.settings.scene.animTime = ls.scene.animations.empty() ? unposed.animTime : pose.time;
   applySceneSettings(ls.settings, ls.scene, verbose);
   return ls;
 }

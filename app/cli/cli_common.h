@@ -57,6 +57,18 @@ std::vector<OptionSpec> sceneInputOptionSpecs();
 // (defaults: LoadOptions{}); each bad value is an error naming the option.
 LoadOptions loadOptionsFrom(const Options& opts);
 
+// The glTF animation options (docs/animation.md): --anim-time SECONDS, --frame N, --fps F,
+// --animation NAME|INDEX|all. Part of sceneOptionSpecs().
+std::vector<OptionSpec> animationOptionSpecs();
+// The pose they ask for: the time is --anim-time, or --frame N / --fps F (default 24), else 0; each bad
+// value or combination is an error naming the option. "first" stands for ScenePose's "" (the first).
+ScenePose scenePoseFrom(const Options& opts);
+// Whether the command line chose a time (--anim-time, --frame or, for render, --frames).
+bool animationTimeGiven(const Options& opts);
+// "2 animations: 0 'move' 0-2 s (5 channels), 1 'spin' 0-0.5 s (1 channel); showing 0 'move' at t = 0 s",
+// or "none".
+std::string animationsSummary(const Scene& scene);
+
 // Parses "W" or "WxH". With only W, H follows the camera's aspect ratio (or is W).
 void parseSize(const std::string& text, float cameraAspect, int& width, int& height);
 
@@ -71,6 +83,10 @@ struct LoadedScene {
 // (imageSettingsFrom; --size defaults to `defaultWidth` pixels wide) and applies their scene side
 // (applySceneSettings: --light-radius, --env..., --background).
 LoadedScene loadSceneForCli(const std::string& nameOrPath, const Options& opts, bool verbose, int defaultWidth = 512);
+// The steps of loadSceneForCli after loading, for a scene posed elsewhere (render --frames: one file, a
+// pose per frame): camera, image settings (with `pose` as the animation settings), scene settings.
+LoadedScene prepareLoadedScene(Scene scene, const Options& opts, const ScenePose& pose, bool verbose,
+                               int defaultWidth = 512);
 // The same for the command's one positional scene argument (default: the bundled default scene).
 LoadedScene loadSceneForCli(const Options& opts, bool verbose, int defaultWidth = 512);
 int cameraIndexFrom(const Options& opts);  // --camera N, default 0

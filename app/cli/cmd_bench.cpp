@@ -20,7 +20,7 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--dispersion", "", "LIST", "dispersion modes for scenes with dispersive glass (default rgb,spectral)"},
       {"--adaptive-bound", "", "",
        "no measured runs: print the gain over uniform sampling that the best allocation of samples over tiles "
-       "can reach, from a uniform mis render's even/odd halves (docs/benchmarks.md)"},
+       "can reach, from a uniform mis render's even/odd halves (docs/adaptive-sampling.md)"},
       {"--bound-spp", "", "N", "samples per pixel of --adaptive-bound's render (default: half the reference's)"},
       {"--reference", "", "FILE", "linear .exr/.pfm reference (one scene, one mode) instead of rendering one"},
       {"--reference-spp", "", "N", "samples per pixel of rendered references (default: bench/scenes.json, else 1024)"},

@@ -45,10 +45,12 @@ std::string vec(const glm::vec3& v) {
 int cmdInfo(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {{"--camera", "", "N", "describe the scene's N-th camera (default 0)"}};
   for (OptionSpec& s : environmentOptionSpecs()) specs.push_back(std::move(s));
+  for (OptionSpec& s : animationOptionSpecs()) specs.push_back(std::move(s));
   for (OptionSpec& s : sceneInputOptionSpecs()) specs.push_back(std::move(s));
   Options opts("caustica info SCENE [--camera N] [options]",
                "Prints triangles, emitters (count, total power), punctual lights, materials by kind, bounds, camera,\n"
-               "BVH statistics and the shader features the scene needs. Needs no GPU.",
+               "animations (and the pose described), BVH statistics and the shader features the scene needs. Needs\n"
+               "no GPU.",
                specs);
   if (!opts.parse(args)) return 0;
   if (opts.positional().empty()) throw Error("info needs a scene (a .gltf/.glb file or a bundled scene name)");
@@ -101,6 +103,7 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("materials:  %zu\n", s.materials.size());
   for (const auto& [k, n] : kinds) std::printf("            %d x %s\n", n, k.c_str());
   std::printf("textures:   %zu\n", s.textures.size());
+  std::printf("animation:  %s\n", animationsSummary(s).c_str());
   std::printf("bounds:     %s to %s\n", vec(s.bounds.min).c_str(), vec(s.bounds.max).c_str());
   if (s.origin != glm::dvec3(0.0))  // far from the world origin: positions above are relative to it
     std::printf("origin:     (%.17g, %.17g, %.17g) (rebased in double; bounds and camera are relative to it)\n",

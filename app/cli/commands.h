@@ -11,5 +11,6 @@ int cmdInfo(const std::vector<std::string>& args);
 int cmdView(const std::vector<std::string>& args);
 int cmdBench(const std::vector<std::string>& args);
 int cmdCompare(const std::vector<std::string>& args);
+int cmdMerge(const std::vector<std::string>& args);
 
 }  // namespace caustica::cli

@@ -83,6 +83,9 @@ ImageSettings imageSettingsFrom(const Options& opts, const Camera& camera, int d
   s.render = renderSettingsFrom(opts, camera, defaultWidth);
   s.scene = sceneSettingsFrom(opts);
   s.camera = cameraIndexFrom(opts);
+  const ScenePose pose = scenePoseFrom(opts);  // --animation, --anim-time or --frame / --fps
+  s.scene.animation = pose.animation.empty() ? "first" : pose.animation;
+  s.scene.animTime = pose.time;
   s.tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", s.tone.exposureStops));
   s.tone.curve = parseToneCurve(opts.get("--tonemap", toneCurveName(s.tone.curve)));
   return s;

@@ -28,6 +28,11 @@ struct SceneSettings {
   float envRotation = 0.0f;          // --env-rotation: degrees about +Y, right-handed
   std::string background = "env";    // --background: "env", "transparent" or a colour ("0.2", "R,G,B")
   float lightRadius = 0.0f;          // --light-radius in scene units; 0: point and spot lights stay points
+  // The glTF animation pose (docs/animation.md): --animation ("first", "all", a name or an index) and
+  // the time in seconds (--anim-time, or --frame N / --fps F). Loading applies them (scenePoseFrom);
+  // for a file without animations they stay at "first" and 0 (nothing moves).
+  std::string animation = "first";
+  double animTime = 0.0;
 };
 
 struct ImageSettings {
@@ -49,8 +54,10 @@ void visitSceneFields(S& s, Visit&& visit) {
   visit("env-rotation", SettingRole::Accumulation, s.envRotation);
   visit("background", SettingRole::Accumulation, s.background);
   visit("light-radius", SettingRole::Accumulation, s.lightRadius);
+  visit("animation", SettingRole::Accumulation, s.animation);
+  visit("anim-time", SettingRole::Accumulation, s.animTime);
 }
-static_assert(fieldCount<SceneSettings>() == 5, "SceneSettings has a field that visitSceneFields does not list");
+static_assert(fieldCount<SceneSettings>() == 7, "SceneSettings has a field that visitSceneFields does not list");
 
 template <class S, class Visit>
 void visitToneFields(S& s, Visit&& visit) {

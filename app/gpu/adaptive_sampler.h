@@ -13,13 +13,13 @@ constexpr int kMinAdaptiveSpp = 16;  // no tile stops before every pixel has thi
 constexpr int kTileDilation = 1;     // a tile with over 4x the mean gain keeps its 8 neighbours live
 constexpr int kMaxSppRatio = 8;      // no tile falls behind the most sampled one by more than this factor
 constexpr double kVarianceSmoothing = 0.5;  // weight of the 3x3 tile neighbourhood in a tile's variance (liveTiles)
-constexpr int kAdaptiveTile = 4;     // side of the tiles in pixels (1, 2, 4 or 8): 4 pays best (docs/benchmarks.md)
+constexpr int kAdaptiveTile = 4;     // side of the tiles in pixels (1, 2, 4 or 8): 4 pays best (docs/adaptive-sampling.md)
 
 // kAdaptiveTile, or the environment variable CAUSTICA_ADAPTIVE_TILE (1, 2, 4 or 8) where set: a knob
-// to measure other tile sizes with (docs/benchmarks.md, "Adaptive sampling"). Throws Error otherwise.
+// to measure other tile sizes with (docs/adaptive-sampling.md, "How much it can gain"). Throws Error otherwise.
 int defaultAdaptiveTile();
 // kMaxSppRatio, or the environment variable CAUSTICA_ADAPTIVE_RATIO (an integer >= 1) where set: a knob
-// to measure the ratio guard with (docs/benchmarks.md, "Adaptive sampling"). Throws Error otherwise.
+// to measure the ratio guard with (docs/adaptive-sampling.md, "How much it can gain"). Throws Error otherwise.
 int defaultMaxSppRatio();
 // kVarianceSmoothing, or the environment variable CAUSTICA_ADAPTIVE_SMOOTHING (a number in [0, 1]) where
 // set: a knob to measure the smoothing with (0 = each tile's own estimate). Throws Error otherwise.

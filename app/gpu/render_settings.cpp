@@ -58,6 +58,11 @@ std::string settingText(float v) {
   const auto r = std::to_chars(buf, buf + sizeof buf, v);  // the shortest text that reads back as v
   return std::string(buf, r.ptr);
 }
+std::string settingText(double v) {
+  char buf[40];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // the shortest text that reads back as v
+  return std::string(buf, r.ptr);
+}
 std::string settingText(bool v) { return v ? "on" : "off"; }
 std::string settingText(const std::string& v) { return v; }
 std::string settingText(Integrator v) { return integratorName(v); }

@@ -39,7 +39,7 @@ struct RenderSettings {
   RenderMode mode = RenderMode::Path;
   // Compile every material feature into the path tracer, whatever the scene uses (the shader is
   // otherwise specialised to the scene's features): measures what specialisation saves
-  // (docs/benchmarks.md). The expected image does not change.
+  // (docs/benchmarks.md, "Specialisation"). The expected image does not change.
   bool allFeatures = false;
   // Samples per pixel one path-tracing dispatch traces (path regeneration, pathtrace.comp): 0 chooses
   // automatically; any value is lowered to what keeps llvmpipe's loop cap out of reach for the depth
@@ -52,7 +52,7 @@ struct RenderSettings {
   bool operator!=(const RenderSettings& o) const { return !(*this == o); }
 };
 
-// What a setting changes, for visitFields' users (docs/long-renders.md, "What must match"):
+// What a setting changes, for visitFields' users (docs/long-renders.md, "Resuming": what must match):
 enum class SettingRole {
   // The samples themselves (their expectation or their random streams): part of the accumulation
   // identity, which two renders must share to add their samples (resume, shards, merge).
@@ -96,6 +96,7 @@ static_assert(fieldCount<RenderSettings>() == 10, "RenderSettings has a field th
 std::string settingText(int v);
 std::string settingText(std::uint32_t v);
 std::string settingText(float v);
+std::string settingText(double v);
 std::string settingText(bool v);  // "on" | "off"
 std::string settingText(const std::string& v);
 std::string settingText(Integrator v);

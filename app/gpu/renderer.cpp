@@ -11,6 +11,7 @@
 #include "accel/tlas.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
+#include "util/hash.h"
 #include "util/memory_stats.h"
 
 namespace caustica {
@@ -84,10 +85,22 @@ Bounds treeBounds(const std::vector<gpu::BvhNode>& nodes) {
 
 }  // namespace
 
-Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings)
-    : library_(library), settings_(settings), camera_(camera) {
+Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings,
+                   const RendererOptions& options)
+    : library_(library), options_(options), settings_(settings), camera_(camera) {
   checkLimits();
   created_ = std::chrono::steady_clock::now();
+  loadScene(scene);
+  transparent_ = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
+  allocateImages();
+  const auto t1 = std::chrono::steady_clock::now();
+  prepareMode();  // compile now, so shader errors surface before rendering starts
+  load_.compile = secondsSince(t1);
+  memTrace("compiled");
+  load_.ready = secondsSince(created_);
+}
+
+void Renderer::loadScene(const Scene& scene) {
   memTrace("renderer start");
   std::vector<gpu::BvhWideNode> wideNodes = buildScene(scene);
   const Bounds sceneBounds = treeBounds(gpuScene_.nodes);
@@ -99,12 +112,23 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
   glFinish();
   load_.upload = secondsSince(t0);
   memTrace("upload done");
-  transparent_ = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
-  allocateImages();
+}
+
+void Renderer::setScene(const Scene& scene, const Camera& camera) {
+  created_ = std::chrono::steady_clock::now();
+  load_ = LoadTimes{};
+  camera_ = camera;
+  raster_.reset();  // the raster pipeline holds the previous scene's mesh
+  loadScene(scene);
+  const bool transparent = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
+  if (transparent != transparent_) {
+    transparent_ = transparent;
+    allocateImages();  // the coverage image comes or goes (and clears the others)
+  }
+  reset();
   const auto t1 = std::chrono::steady_clock::now();
-  prepareMode();  // compile now, so shader errors surface before rendering starts
+  prepareMode();  // the scene's variant: compiled once, the same features find it in programs_
   load_.compile = secondsSince(t1);
-  memTrace("compiled");
   load_.ready = secondsSince(created_);
 }
 
@@ -123,12 +147,27 @@ std::vector<gpu::BvhWideNode> Renderer::buildScene(const Scene& scene) {
   auto t0 = std::chrono::steady_clock::now();
   std::vector<gpu::BvhWideNode> wideNodes;  // what traverse.glsl reads in flat scenes
   if (!scene.instances.empty()) {  // two-level BVH over the stored meshes (tlas.h, docs/instancing.md)
-    InstancedBvh ib = buildInstancedBvh(scene);
+    InstancedBvh ib;
+    if (options_.sceneUpdates) {
+      // Animation sequences: the meshes' BVHs are kept while the stored triangles stay the same (a
+      // rigid animation moves only instances), and only the top level is built again.
+      std::uint64_t key = fnv1a64(scene.triangles.data(), scene.triangles.size() * sizeof(Triangle));
+      key = fnv1a64(scene.meshes.data(), scene.meshes.size() * sizeof(MeshRange), key);
+      if (!meshBvhs_ || meshBvhsKey_ != key) {
+        meshBvhs_ = std::make_unique<MeshBvhs>(buildMeshBvhs(scene));
+        meshBvhsKey_ = key;
+        ++meshBvhBuilds_;
+      }
+      ib = placeInstances(scene, *meshBvhs_);
+    } else {
+      ib = buildInstancedBvh(scene);
+    }
     bvhSeconds_ = load_.bvh = secondsSince(t0);
     bvh_.depth = ib.depth;
     t0 = std::chrono::steady_clock::now();
     gpuScene_ = packInstancedScene(scene, ib);
   } else {
+    meshBvhs_.reset();
     const BvhShape shape = bvhShapeFromEnv();
     bvh_ = buildBvh(scene.triangles, shape.build);
     memTrace("bvh built");
@@ -381,7 +420,7 @@ namespace {
 // a furnace, depth 1024) check to lose no energy, so K samples get that bound and no more.
 constexpr int kRegenBounceBudget = 1024;
 constexpr int kDefaultSamplesPerDispatch = 4;  // docs/benchmarks.md, "Path regeneration"
-constexpr int kMaxPassThroughs = 256;          // pathtrace.comp's kMaxPassThroughs
+constexpr int kMaxPassThroughs = 256;          // path_state.glsl's kMaxPassThroughs
 }  // namespace
 
 int Renderer::samplesPerDispatch() const {
@@ -509,15 +548,20 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
   sampleBase_ = state.sampleBase;
 }
 
-Image Renderer::image() const {
-  std::vector<float> rgba = accum_.readRgba32f();
-  Image img{settings_.width, settings_.height, std::vector<float>(static_cast<size_t>(settings_.width) * settings_.height * 3)};
-  for (size_t i = 0; i < static_cast<size_t>(settings_.width) * settings_.height; ++i) {
+void Renderer::startAtSample(std::uint32_t index) {
+  if (spp_ != 0) throw Error("internal: startAtSample on a render that has samples");
+  sampleBase_ = index;
+}
+
+Image meanImage(int width, int height, const std::vector<float>& rgba, const std::vector<float>* coverage) {
+  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+  Image img{width, height, std::vector<float>(pixels * 3)};
+  for (size_t i = 0; i < pixels; ++i) {
     float n = rgba[i * 4 + 3];
     for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = n > 0.0f ? rgba[i * 4 + c] / n : 0.0f;
   }
-  if (hasAlpha()) {  // rgb stays the mean over all samples (misses add 0): premultiplied by alpha
-    std::vector<float> hits = coverage_.readR32f();
+  if (coverage) {  // rgb stays the mean over all samples (misses add 0): premultiplied by alpha
+    const std::vector<float>& hits = *coverage;
     img.alpha.resize(hits.size());
     for (size_t i = 0; i < hits.size(); ++i) {
       float n = rgba[i * 4 + 3];
@@ -525,6 +569,13 @@ Image Renderer::image() const {
     }
   }
   return img;
+}
+
+Image Renderer::image() const {
+  const std::vector<float> rgba = accum_.readRgba32f();
+  if (!hasAlpha()) return meanImage(settings_.width, settings_.height, rgba, nullptr);
+  const std::vector<float> hits = coverage_.readR32f();
+  return meanImage(settings_.width, settings_.height, rgba, &hits);
 }
 
 const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {

@@ -24,10 +24,12 @@
 #include "image/error_estimate.h"
 #include "image/tonemap.h"
 #include "scene/light_groups.h"
+#include "util/field_count.h"
 
 namespace caustica {
 
 class RasterRenderer;
+struct MeshBvhs;
 
 // The PointLights UBO of the raster and Whitted modes: the emitter `groups`, then the scene's punctual
 // lights (at most CAUSTICA_MAX_POINT_LIGHTS in all), with each light's shadow far distance reaching the
@@ -53,6 +55,25 @@ struct AccumulationState {
                                 // the background is transparent
 };
 
+// The per-pixel sums of an AccumulationState that are plain sums of per-sample values (no compensation
+// term), each as visit(name, images): what adding two states together (merge of shards, cli/shard.h)
+// adds besides accum/comp, which are a Kahan pair. An image empty in a state is absent in it. A field
+// added to AccumulationState (e.g. another per-pixel sum: feature buffers) must be listed here (or
+// beside accum/comp): the static_assert fails the build until it is, so that merged renders never drop
+// a sum; merge then adds it and refuses parts that hold it next to parts that do not.
+template <class State, class Visit>
+void visitPlainSums(State& s, Visit&& visit) {
+  visit("half", s.half);
+  visit("coverage", s.coverage);
+}
+static_assert(fieldCount<AccumulationState>() == 8,
+              "AccumulationState has a field that visitPlainSums (or the accum/comp pair) does not cover");
+
+// The mean radiance of each pixel from its running sums (rgb / count; 0 where a pixel has no sample),
+// and with `coverage` (hits per pixel) the alpha. Renderer::image() and merge (cli/shard.h) share it, so a
+// merged render's image is computed exactly as one machine's.
+Image meanImage(int width, int height, const std::vector<float>& accum, const std::vector<float>* coverage);
+
 // Seconds the Renderer spent getting a scene ready (docs/benchmarks.md, "Big scenes").
 struct LoadTimes {
   double bvh = 0.0, pack = 0.0, upload = 0.0, compile = 0.0;
@@ -60,11 +81,29 @@ struct LoadTimes {
   double firstPass = 0.0;    // from the start of the constructor to the end of the first pass (0: none yet)
 };
 
+// How a Renderer will be used beyond one scene.
+struct RendererOptions {
+  // setScene will follow (animation sequences, docs/animation.md): keep the bottom-level BVHs of an
+  // instanced scene on the host (about the meshes' BVH and triangle records again) so that a scene whose
+  // stored meshes did not change only re-places its instances.
+  bool sceneUpdates = false;
+};
+
 class Renderer {
  public:
   // Needs a current GL 4.3 context. Throws Error if the scene exceeds the GL limits.
-  Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings);
+  Renderer(const ShaderLibrary& library, const Scene& scene, const Camera& camera, const RenderSettings& settings,
+           const RendererOptions& options = {});
   ~Renderer();
+
+  // Another scene with the same settings (the next frame of an animation): uploads it and restarts
+  // accumulation, keeping what does not depend on the scene: the GL context's compiled shader variants
+  // (the same features reuse theirs), the images (unless the coverage image comes or goes) and, with
+  // RendererOptions::sceneUpdates, the bottom-level BVHs of meshes that did not change (a rigid
+  // animation of an instanced scene rebuilds only the top level). A flat scene's BVH is built again.
+  void setScene(const Scene& scene, const Camera& camera);
+  // Bottom-level BVH builds so far (RendererOptions::sceneUpdates; tests check that rigid frames add none).
+  int meshBvhBuilds() const { return meshBvhBuilds_; }
 
   void setCamera(const Camera& camera);          // restarts accumulation
   // The one place that decides what a settings change needs: new images, another shader variant,
@@ -102,6 +141,10 @@ class Renderer {
   // Continues from `state` (saved from a renderer with the same scene and settings): the next pass
   // renders exactly the samples an uninterrupted render would. Throws Error unless its size matches.
   void restoreAccumulation(const AccumulationState& state);
+  // Makes `index` the global index of the next sample (the RNG's sample dimension) of a render that has
+  // no samples yet: a shard of a render starts at the first sample of its share (cli/shard.h).
+  // Throws Error if samples were already added.
+  void startAtSample(std::uint32_t index);
   Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
   // --background transparent in a mode that tracks coverage (the CAUSTICA_TRANSPARENT row): image()
   // has alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
@@ -132,8 +175,9 @@ class Renderer {
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
-  // The constructor's steps, in order.
+  // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
+  void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
   std::vector<gpu::BvhWideNode> buildScene(const Scene& scene);  // BVH and GpuScene; flat: the 4-wide nodes
   void planBuffers(const Scene& scene);    // binary nodes cut to the root (flat), the storage blocks' plan
   void uploadScene(const Scene& scene, std::vector<gpu::BvhWideNode> wideNodes);  // buffers and textures
@@ -141,6 +185,10 @@ class Renderer {
   void uploadLights(const Scene& scene, const Bounds& sceneBounds);  // point lights, environment
 
   const ShaderLibrary& library_;
+  RendererOptions options_;
+  std::unique_ptr<MeshBvhs> meshBvhs_;  // sceneUpdates: the instanced scene's bottom levels, and
+  std::uint64_t meshBvhsKey_ = 0;       // the hash of the stored triangles and meshes they were built from
+  int meshBvhBuilds_ = 0;
   RenderSettings settings_;
   Camera camera_;
   Bvh bvh_;

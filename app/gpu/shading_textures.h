@@ -1,7 +1,7 @@
 // shading_textures.h — the buffer textures through which the shaders read the materials, the light-tree
 // nodes, the texture block and the TriShade words (bindings.glsl, light_tree.glsl, textures.glsl,
 // tri_shade.glsl): views of those buffers, no copies. On llvmpipe a texelFetch is a vector gather, an SSBO
-// load a loop over the SIMD lanes (docs/benchmarks.md, "Session 5").
+// load a loop over the SIMD lanes (docs/architecture.md, "Writing shaders for llvmpipe").
 #pragma once
 #include <string>
 

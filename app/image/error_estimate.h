@@ -50,11 +50,11 @@ double pixelChannelRelMse(double sumA, double nA, double sumB, double nB);
 // `smoothing` in [0, 1]: the gain is taken from each tile's per-sample variance e n blended with the
 // mean over its 3x3 tile neighbourhood, (1 - smoothing) own + smoothing neighbourhood: a 4x4 tile's
 // own estimate swings with single bright samples and misses rare paths its neighbours share
-// (docs/adaptive-sampling.md, docs/benchmarks.md "Adaptive sampling": 0.5 allocates better).
+// (docs/adaptive-sampling.md, "How much it can gain": 0.5 allocates better).
 std::vector<std::uint32_t> liveTiles(const ErrorEstimate& estimate, int minSpp, int maxSppRatio, int dilation,
                                      double smoothing = 0.0);
 
-// How much adaptive sampling can gain at all (docs/benchmarks.md, "Adaptive sampling"). `tileVariance`:
+// How much adaptive sampling can gain at all (docs/adaptive-sampling.md, "How much it can gain"). `tileVariance`:
 // each tile's per-sample relative variance v (relMSE x samples per pixel under uniform sampling; tiles
 // of equal size). The image's mean relMSE, mean(v / n), is least for a given mean n when n is
 // proportional to sqrt(v); that allocation's gain over uniform sampling is mean(v) / mean(sqrt(v))^2.

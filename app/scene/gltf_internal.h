@@ -26,6 +26,7 @@
 #pragma GCC diagnostic pop
 
 #include "util/error.h"
+#include "scene/animation.h"
 #include "scene/scene.h"
 
 namespace caustica::gltf {
@@ -110,14 +111,28 @@ struct NodeTransform {
   bool flip = false;       // negative determinant: glTF then defines clockwise fronts
 };
 
-// Converts a loaded tinygltf model into `scene`: materials, the default scene's node tree, cameras
-// and world-space triangles. Its member functions are defined in gltf_nodes.cpp (build, the node
-// walk, meshes, cameras), gltf_materials.cpp (materials, textures) and gltf_accessors.cpp (accessors).
+// How one mesh placement is posed (gltf_animation.cpp): its morph-target weights and its skin.
+struct MeshPose {
+  std::vector<double> weights;  // one per morph target of the mesh; empty or all zero: the base shape
+  int skin = -1;                // skins[] index: vertices placed by their joints, the node's transform ignored
+  bool posed() const {
+    if (skin >= 0) return true;
+    for (double w : weights)
+      if (w != 0.0) return true;
+    return false;
+  }
+};
+
+// Converts a loaded tinygltf model into `scene`: materials, the default scene's node tree posed at
+// `pose` (animations, morph weights, skins), cameras and world-space triangles. Its member functions
+// are defined in gltf_nodes.cpp (build, the node walk, meshes, cameras), gltf_animation.cpp
+// (animations, morph targets, skins), gltf_materials.cpp (materials, textures) and gltf_accessors.cpp
+// (accessors).
 class SceneBuilder {
  public:
   SceneBuilder(const std::string& path, const tinygltf::Model& model, const ImageLog& images,
-               const LoadOptions& options, Scene& scene)
-      : path_(path), model_(model), images_(images), options_(options), scene_(scene) {}
+               const LoadOptions& options, const ScenePose& pose, Scene& scene)
+      : path_(path), model_(model), images_(images), options_(options), pose_(pose), scene_(scene) {}
 
   void build();
 
@@ -143,8 +158,32 @@ class SceneBuilder {
   int extTexture(const tinygltf::Value* ext, const char* key, const std::string& at);
   std::uint32_t defaultMaterial(const std::string& at);
 
+  // ---- animation (gltf_animation.cpp) ----
+  // Reads every animation (for Scene::animations) and samples the chosen one(s) at pose_.time into
+  // animatedTrs_ and animatedWeights_; names the chosen ones in Scene::animationsPlayed.
+  void readAnimations();
+  // The node's morph-target weights at the pose (animated, else node.weights, else mesh.weights).
+  std::vector<double> nodeWeights(int nodeIndex, int mesh, const std::string& at);
+  // World matrices of every node (needed by skins, whose joints may lie anywhere in the tree).
+  void computeNodeWorlds(const std::vector<int>& parent);
+  // skin's joint matrices world(joint) * inverseBindMatrix at the pose (cached per skin).
+  const std::vector<glm::dmat4>& jointMatrices(int skin, const std::string& at);
+  // Positions and normals of one primitive morphed by pose.weights (targets read and checked here).
+  void morphPrimitive(const tinygltf::Primitive& prim, const MeshPose& pose, std::size_t vertexCount,
+                      std::vector<double>& positions, std::vector<double>& normals, const std::string& at);
+  // Positions and normals of one primitive placed by its skin (world space); mirrored[v]: the vertex's
+  // skin matrix has a negative determinant.
+  void skinPrimitive(const tinygltf::Primitive& prim, int skin, std::size_t vertexCount, std::vector<double>& positions,
+                     std::vector<double>& normals, std::vector<bool>& mirrored, const std::string& at);
+  std::map<int, NodeTrs> animatedTrs_;                 // node -> its TRS at the pose (animated nodes only)
+  std::map<int, std::vector<double>> animatedWeights_;  // node -> its morph weights at the pose
+  std::vector<glm::dmat4> nodeWorld_;                   // computeNodeWorlds
+  std::map<int, std::vector<glm::dmat4>> jointMatrices_;
+  std::set<std::string> warnedMorphAttributes_;
+
   // ---- node hierarchy (gltf_nodes.cpp) ----
   glm::dmat4 localMatrix(const tinygltf::Node& node, const std::string& at);
+  glm::dmat4 localMatrix(int nodeIndex, const std::string& at);  // with the animation's TRS, if any
   std::vector<int> checkHierarchy();
   void traverse();  // fills cameraInstances_ and meshInstances_
   // Refuses a scene whose mesh instances declare more than options_.maxTriangles triangles (from
@@ -177,19 +216,22 @@ class SceneBuilder {
                                     const std::string& at);
 
   // ---- meshes (gltf_nodes.cpp) ----
-  void addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt);
-  // keepInstances: the mesh's triangles once in object space (on first use), then an Instance.
-  void addInstance(int meshIndex, const NodeTransform& xf, const std::string& nodeAt);
+  void addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt, const MeshPose& pose = {});
+  // keepInstances: the mesh's triangles once in object space (on first use; a posed mesh once per
+  // placement), then an Instance.
+  void addInstance(int meshIndex, const NodeTransform& xf, const std::string& nodeAt, const MeshPose& pose = {});
   // EXT_mesh_gpu_instancing on a node: one local TRS matrix per instance (empty without the extension).
   std::vector<glm::dmat4> gpuInstances(const tinygltf::Node& node, const std::string& at);
   // A mesh placement (node world transform) as a MeshInstance, or skipped when singular.
-  void placeMesh(int mesh, const glm::dmat4& world, const std::string& at);
-  void addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at);
+  void placeMesh(int mesh, const glm::dmat4& world, const std::string& at, const MeshPose& pose = {});
+  void addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at,
+                    const MeshPose& pose = {});
 
   const std::string& path_;
   const tinygltf::Model& model_;
   const ImageLog& images_;
   LoadOptions options_;  // a copy: autoInstances settles keepInstances in build()
+  ScenePose pose_;
   Scene& scene_;
   std::map<int, int> textureMap_;  // glTF texture index -> Scene::textures index (-1: ignored)
   // Transformed references (KHR_texture_transform): glTF texture index and rows -> Scene::textures index.
@@ -200,8 +242,6 @@ class SceneBuilder {
   std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable
   std::size_t candidates_ = 0;   // triangles assembled so far, degenerate ones included
   std::uint64_t decoded_ = 0;    // accessor elements decoded so far
-  bool warnedSkin_ = false;
-  bool warnedTargets_ = false;
   std::string firstSkip_;  // first reason a primitive was skipped, quoted when nothing is left
   // Instances met in the node walk, converted once the origin is known.
   struct CameraInstance {
@@ -213,6 +253,7 @@ class SceneBuilder {
     int mesh = -1;
     NodeTransform xf;
     std::string at;
+    MeshPose pose;
   };
   std::vector<CameraInstance> cameraInstances_;
   std::vector<MeshInstance> meshInstances_;

@@ -163,8 +163,30 @@ std::string glbJson(const std::string& path, const std::vector<unsigned char>& b
 
 Scene loadScene(const std::string& path) { return loadScene(path, LoadOptions{}); }
 
-Scene loadScene(const std::string& path, const LoadOptions& options) {
+Scene loadScene(const std::string& path, const LoadOptions& options) { return loadScene(path, options, ScenePose{}); }
+
+Scene loadScene(const std::string& path, const LoadOptions& options, const ScenePose& pose) {
+  return SceneFile(path, options).sceneAt(pose);
+}
+
+// The parsed document: what SceneBuilder reads for every pose.
+struct SceneFile::Document {
+  std::string path;
+  LoadOptions options;
+  tinygltf::Model model;
+  gltf::ImageLog imageLog;
+  std::vector<std::string> warnings;  // the file's own (GLB in .gltf, tinygltf's), copied into each Scene
+};
+
+SceneFile::~SceneFile() = default;
+SceneFile::SceneFile(SceneFile&&) noexcept = default;
+SceneFile& SceneFile::operator=(SceneFile&&) noexcept = default;
+const std::string& SceneFile::path() const { return doc_->path; }
+
+SceneFile::SceneFile(const std::string& path, const LoadOptions& options) : doc_(std::make_unique<Document>()) {
   using namespace gltf;  // the loader's internals (gltf_internal.h)
+  doc_->path = path;
+  doc_->options = options;
   const std::string ext = lowerExtension(path);
   if (ext != ".gltf" && ext != ".glb")
     throw Error(path + ": unsupported file extension '" + oneLine(ext) + "' (supported: .gltf, .glb)");
@@ -173,11 +195,9 @@ Scene loadScene(const std::string& path, const LoadOptions& options) {
 
   // glTF-Binary is recognised by its magic, whatever the extension says.
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-  Scene scene;
-  scene.path = path;
   if (binary != (ext == ".glb")) {
     if (ext == ".glb") glbJson(path, bytes);  // reports the bad header
-    scene.warnings.push_back(path + ": binary glTF content in a .gltf file; loaded as GLB");
+    doc_->warnings.push_back(path + ": binary glTF content in a .gltf file; loaded as GLB");
   }
   const std::string jsonText =
       binary ? glbJson(path, bytes) : std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size());
@@ -192,8 +212,8 @@ Scene loadScene(const std::string& path, const LoadOptions& options) {
   }
   checkJson(path, jsonText, access, binary, options);
 
-  tinygltf::Model model;
-  ImageLog imageLog;
+  tinygltf::Model& model = doc_->model;
+  ImageLog& imageLog = doc_->imageLog;
   imageLog.budget = options.maxTextureBytes;
   try {
     tinygltf::TinyGLTF loader;
@@ -206,15 +226,22 @@ Scene loadScene(const std::string& path, const LoadOptions& options) {
                                                         static_cast<unsigned int>(jsonText.size()), access.baseDir);
     if (!imageLog.overBudget.empty()) throw Error(path + ": " + imageLog.overBudget);
     if (!ok) throw Error(path + ": " + (err.empty() ? std::string("tinygltf could not load the file") : oneLine(err)));
-    if (!warn.empty()) scene.warnings.push_back(path + ": " + oneLine(warn));
+    if (!warn.empty()) doc_->warnings.push_back(path + ": " + oneLine(warn));
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
     throw Error(path + ": " + oneLine(e.what()));
   }
+}
 
+Scene SceneFile::sceneAt(const ScenePose& pose) const {
+  using namespace gltf;
+  const std::string& path = doc_->path;
+  Scene scene;
+  scene.path = path;
+  scene.warnings = doc_->warnings;
   try {
-    SceneBuilder(path, model, imageLog, options, scene).build();
+    SceneBuilder(path, doc_->model, doc_->imageLog, doc_->options, pose, scene).build();
   } catch (const Error&) {
     throw;
   } catch (const std::bad_alloc&) {

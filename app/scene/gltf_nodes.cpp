@@ -23,6 +23,7 @@ void SceneBuilder::build() {
   warnUnsupportedExtensions();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
   keepUv_ = keepsTexcoords(scene_.materials);  // the default material added later reads none
+  readAnimations();  // gltf_animation.cpp: the pose's node TRS and morph weights
   traverse();
   if (options_.keepInstances && options_.autoInstances) options_.keepInstances = instancingPays();
   checkTriangleCount();
@@ -32,8 +33,8 @@ void SceneBuilder::build() {
   scene_.origin = origin_;
   for (const CameraInstance& c : cameraInstances_) addCamera(c.camera, c.world, model_.nodes[std::size_t(c.node)], c.at);
   for (const MeshInstance& m : meshInstances_) {
-    if (options_.keepInstances) addInstance(m.mesh, m.xf, m.at);
-    else addMesh(m.mesh, m.xf, m.at);
+    if (options_.keepInstances) addInstance(m.mesh, m.xf, m.at, m.pose);
+    else addMesh(m.mesh, m.xf, m.at, m.pose);
   }
   for (const CameraInstance& l : lightInstances_) addLight(l.camera, l.world, l.at);
   if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
@@ -154,6 +155,11 @@ glm::dmat4 SceneBuilder::localMatrix(const tinygltf::Node& node, const std::stri
   return m;
 }
 
+glm::dmat4 SceneBuilder::localMatrix(int nodeIndex, const std::string& at) {
+  const auto it = animatedTrs_.find(nodeIndex);
+  return it != animatedTrs_.end() ? trsMatrix(it->second) : localMatrix(model_.nodes[std::size_t(nodeIndex)], at);
+}
+
 // Rejects children out of range, nodes with two parents and cycles, so the walk below terminates.
 std::vector<int> SceneBuilder::checkHierarchy() {
   const std::size_t n = model_.nodes.size();
@@ -191,6 +197,7 @@ std::vector<int> SceneBuilder::checkHierarchy() {
 
 void SceneBuilder::traverse() {
   const std::vector<int> parent = checkHierarchy();
+  if (!model_.skins.empty()) computeNodeWorlds(parent);  // joints may lie anywhere in the tree
   std::vector<int> roots;
   if (model_.scenes.empty()) {
     for (std::size_t i = 0; i < parent.size(); ++i)
@@ -221,27 +228,30 @@ void SceneBuilder::traverse() {
     visited[std::size_t(index)] = true;
     const tinygltf::Node& node = model_.nodes[std::size_t(index)];
     NodeTransform xf;
-    xf.world = parentWorld * localMatrix(node, at);
+    xf.world = parentWorld * localMatrix(index, at);
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
         if (!std::isfinite(xf.world[c][r])) fail(at + ": its world transform is not finite");
-    if (node.skin >= 0 && !warnedSkin_) {
-      warn(at + ": skins are not supported; meshes are drawn in their bind pose");
-      warnedSkin_ = true;
-    }
     if (node.camera >= 0) cameraInstances_.push_back({node.camera, index, xf.world, at});
     if (const int light = nodeLight(node); light >= 0) lightInstances_.push_back({light, index, xf.world, at});
     if (node.mesh >= 0) {
+      MeshPose pose;  // morph weights and skin (gltf_animation.cpp)
+      if (std::size_t(node.mesh) < model_.meshes.size()) pose.weights = nodeWeights(index, node.mesh, at);
+      pose.skin = node.skin;
       const std::vector<glm::dmat4> gpu = gpuInstances(node, at);
-      if (gpu.empty()) placeMesh(node.mesh, xf.world, at);
+      if (gpu.empty()) placeMesh(node.mesh, xf.world, at, pose);
       for (std::size_t i = 0; i < gpu.size(); ++i)
-        placeMesh(node.mesh, xf.world * gpu[i], at + " (EXT_mesh_gpu_instancing instance " + str(i) + ")");
+        placeMesh(node.mesh, xf.world * gpu[i], at + " (EXT_mesh_gpu_instancing instance " + str(i) + ")", pose);
     }
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, xf.world);
   }
 }
 
-void SceneBuilder::placeMesh(int mesh, const glm::dmat4& world, const std::string& at) {
+void SceneBuilder::placeMesh(int mesh, const glm::dmat4& world, const std::string& at, const MeshPose& pose) {
+  if (pose.skin >= 0) {  // placed by its joints: the node's own transform is ignored (glTF 3.7.3.3)
+    meshInstances_.push_back({mesh, NodeTransform{}, at, pose});
+    return;
+  }
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(world[c][r])) fail(at + ": its world transform is not finite");
@@ -255,7 +265,7 @@ void SceneBuilder::placeMesh(int mesh, const glm::dmat4& world, const std::strin
   xf.world = world;
   xf.normal = glm::transpose(glm::inverse(m3));
   xf.flip = det < 0.0;
-  meshInstances_.push_back({mesh, xf, at});
+  meshInstances_.push_back({mesh, xf, at, pose});
 }
 
 // EXT_mesh_gpu_instancing: TRANSLATION (VEC3 float), ROTATION (VEC4 float or normalized
@@ -383,37 +393,41 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
 }
 
 // ---- meshes ----
-void SceneBuilder::addInstance(int meshIndex, const NodeTransform& xf, const std::string& nodeAt) {
-  auto found = storedMeshes_.find(meshIndex);
+void SceneBuilder::addInstance(int meshIndex, const NodeTransform& xf, const std::string& nodeAt, const MeshPose& pose) {
+  // A posed mesh (morphed or skinned) is its own stored mesh, once per placement.
+  auto found = pose.posed() ? storedMeshes_.end() : storedMeshes_.find(meshIndex);
+  std::uint32_t stored = found == storedMeshes_.end() ? 0u : found->second;
   if (found == storedMeshes_.end()) {
     // Object space: identity transform and no rebasing (the instance carries both).
     const std::size_t first = scene_.triangles.size();
     const glm::dvec3 origin = origin_;
     origin_ = glm::dvec3(0.0);
-    addMesh(meshIndex, NodeTransform{}, nodeAt);
+    addMesh(meshIndex, NodeTransform{}, nodeAt, pose);
     origin_ = origin;
     MeshRange range;
     range.firstTriangle = std::uint32_t(first);
     range.triangleCount = std::uint32_t(scene_.triangles.size() - first);
     range.gltfMesh = meshIndex;
-    found = storedMeshes_.emplace(meshIndex, std::uint32_t(scene_.meshes.size())).first;
+    stored = std::uint32_t(scene_.meshes.size());
+    if (!pose.posed()) storedMeshes_.emplace(meshIndex, stored);
     scene_.meshes.push_back(range);
   }
-  if (scene_.meshes[found->second].triangleCount == 0) return;  // nothing to place
-  scene_.instances.push_back({found->second, xf.world});
+  if (scene_.meshes[stored].triangleCount == 0) return;  // nothing to place
+  scene_.instances.push_back({stored, xf.world});
 }
 
-void SceneBuilder::addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt) {
+void SceneBuilder::addMesh(int meshIndex, const NodeTransform& xf, const std::string& nodeAt, const MeshPose& pose) {
   if (std::size_t(meshIndex) >= model_.meshes.size())
     fail(nodeAt + ".mesh is " + str(std::uint64_t(meshIndex)) + ", but the file has " + str(model_.meshes.size()) +
          " meshes");
   const tinygltf::Mesh& mesh = model_.meshes[std::size_t(meshIndex)];
   for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
-    addPrimitive(mesh.primitives[p], xf,
-                 "meshes[" + str(std::uint64_t(meshIndex)) + "].primitives[" + str(p) + "]");
+    addPrimitive(mesh.primitives[p], xf, "meshes[" + str(std::uint64_t(meshIndex)) + "].primitives[" + str(p) + "]",
+                 pose);
 }
 
-void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at) {
+void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at,
+                                const MeshPose& pose) {
   static const char* const kModeNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
   if (prim.mode >= 0 && prim.mode <= 3) {
     skip(at + ": mode " + kModeNames[prim.mode] + " is not supported (triangles only); primitive skipped");
@@ -424,23 +438,28 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     skip(at + ": mode " + std::to_string(prim.mode) + " is not a valid primitive mode; primitive skipped");
     return;
   }
-  if (!prim.targets.empty() && !warnedTargets_) {
-    warn(at + ": morph targets are not supported; the base shape is used");
-    warnedTargets_ = true;
-  }
   const auto posIt = prim.attributes.find("POSITION");
   if (posIt == prim.attributes.end()) {
     skip(at + " has no POSITION attribute; primitive skipped");
     return;
   }
-  const std::vector<double> positions =
+  std::vector<double> positions =
       readAccessor(posIt->second, TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, at + " POSITION");
   const std::size_t vertexCount = positions.size() / 3;
   for (std::size_t i = 0; i < positions.size(); ++i)
     if (!std::isfinite(positions[i]))
       fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
-  const std::vector<double> normals = readAttribute(
+  std::vector<double> normals = readAttribute(
       prim, "NORMAL", TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, vertexCount, at);
+  // The pose (gltf_animation.cpp): morph targets blended, then skinned meshes placed by their joints
+  // (world space; xf is then the identity). mirrored[v]: vertex v's skin matrix mirrors.
+  std::vector<bool> mirrored;
+  if (pose.posed()) {
+    morphPrimitive(prim, pose, vertexCount, positions, normals, at);
+    if (pose.skin >= 0) skinPrimitive(prim, pose.skin, vertexCount, positions, normals, mirrored, at);
+    for (std::size_t i = 0; i < positions.size(); ++i)
+      if (!std::isfinite(positions[i])) fail(at + ": a posed vertex position is not finite");
+  }
   // Each vertex's world-space normal as its octahedral word (Triangle::normalWord), encoded once per
   // vertex rather than once per corner (a closed mesh has ~6 corners per vertex); kOctNoNormal marks
   // a zero or non-finite one (octEncode never gives it for a unit vector).
@@ -519,7 +538,8 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
 
   for (std::size_t t = 0; t < triangles; ++t) {
     std::uint32_t v[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};
-    if (xf.flip) std::swap(v[1], v[2]);  // negative determinant: restore counter-clockwise fronts
+    // A negative determinant (the node's, or the skin's at the first corner): restore counter-clockwise fronts.
+    if (xf.flip != (!mirrored.empty() && mirrored[v[0]])) std::swap(v[1], v[2]);
     Triangle tri;
     TriangleUv uv;
     tri.material = material;

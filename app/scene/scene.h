@@ -3,11 +3,13 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "scene/animation.h"
 #include "scene/environment.h"
 #include "scene/punctual_lights.h"
 #include "shading/oct_normal.h"
@@ -187,6 +189,11 @@ struct Scene {
   // Set from the command line (--env, --background), not from the file.
   Environment environment;
   Background background;
+  // glTF animations (docs/animation.md): every animation of the file, and the ones the scene was posed
+  // with (indices into `animations`; empty when the file has none) at animationTime seconds.
+  std::vector<AnimationInfo> animations;
+  std::vector<int> animationsPlayed;
+  double animationTime = 0.0;
 };
 
 // Corner k's texture coordinates of triangle i; (0, 0) in a scene that keeps none.
@@ -252,10 +259,29 @@ std::uint64_t placedTriangles(const Scene& scene, const std::vector<bool>& mater
 // How many triangles the instances place in all (what flattenInstances makes, zero-area ones included).
 std::uint64_t instancedTriangleCount(const Scene& scene);
 
-// Loads a .gltf or .glb file. Throws caustica::Error("FILE: what is wrong") on any bad input.
+// Loads a .gltf or .glb file posed at `pose` (its animations, morph-target weights and skins at that
+// time; docs/animation.md). Throws caustica::Error("FILE: what is wrong") on any bad input.
+Scene loadScene(const std::string& path, const LoadOptions& options, const ScenePose& pose);
+// The same at time 0 of the default animation(s) (ScenePose{}), if the file has any.
 Scene loadScene(const std::string& path, const LoadOptions& options);
 // The same with the default LoadOptions.
 Scene loadScene(const std::string& path);
+
+// A scene file read once and posed at many times (render --frames): the parsed and checked document and
+// its decoded images are kept; sceneAt builds the Scene exactly as loadScene(path, options, pose) would.
+class SceneFile {
+ public:
+  SceneFile(const std::string& path, const LoadOptions& options);  // throws Error as loadScene does
+  ~SceneFile();
+  SceneFile(SceneFile&&) noexcept;
+  SceneFile& operator=(SceneFile&&) noexcept;
+  Scene sceneAt(const ScenePose& pose) const;
+  const std::string& path() const;
+
+ private:
+  struct Document;
+  std::unique_ptr<Document> doc_;
+};
 
 // A camera that frames the scene bounds (used when the file has none), looking down -Z.
 Camera autoCamera(const Bounds& bounds);

@@ -61,8 +61,8 @@ glm::vec3 bsdfEval(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi);
 // Solid-angle density with which bsdfSample produces wi.
 float bsdfPdf(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi);
 // bsdfEval (out f) and bsdfPdf (returned) of one wi: the twin of glsl/lib/microfacet.glsl's bsdfEvalPdf,
-// which computes both in one body for every lobe (llvmpipe runs every branch; docs/benchmarks.md,
-// "Session 7"), with the same values as the two functions here.
+// which computes both in one body for every lobe (llvmpipe runs every branch; docs/architecture.md,
+// "Writing shaders for llvmpipe"), with the same values as the two functions here.
 float bsdfEvalPdf(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi, glm::vec3& f);
 // Samples wi; u.x chooses between parts (specular/diffuse, reflection/refraction), u.yz the direction.
 // False when the sample is lost (below the surface): the path ends.

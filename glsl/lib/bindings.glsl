@@ -3,8 +3,8 @@
 #include "../shared/gpu_layout.h"
 
 // Every scene array is read through a buffer texture over its buffer (texelFetch is a vector gather on
-// llvmpipe; an SSBO load there is a loop over the lanes, 1.0-1.3x slower overall: docs/benchmarks.md,
-// "Session 5"): the BVH and the triangle positions for traversal,
+// llvmpipe; an SSBO load there is a loop over the lanes, 1.0-1.3x slower overall: docs/architecture.md,
+// "Writing shaders for llvmpipe"): the BVH and the triangle positions for traversal,
 layout(binding = CAUSTICA_TEXUNIT_BVH_NODES) uniform usamplerBuffer bvhNodeTexels;  // 4 texels per BvhNode
 layout(binding = CAUSTICA_TEXUNIT_TRI_GEOM) uniform usamplerBuffer triGeomTexels;   // 3 texels per TriGeom
 layout(binding = CAUSTICA_TEXUNIT_BVH_WIDE) uniform usamplerBuffer bvhWideTexels;   // 7 texels per BvhWideNode

@@ -63,7 +63,8 @@ bool sampleEnvironment(vec2 u, out vec3 dir, out vec3 le, out float pdf) {
   int w = int(environment.size.x), h = int(environment.size.y);
   // Row: smallest y with marginal CDF > u.y (binary search; the same steps as the C++ twin). Bottom-tested
   // loops: llvmpipe runs a loop's whole body (masked) in the iteration whose test at the top ends it, so
-  // `while (lo < hi)` cost one CDF fetch and step more than the search (docs/benchmarks.md, "Session 7").
+  // `while (lo < hi)` cost one CDF fetch and step more than the search (docs/architecture.md, "Writing shaders
+  // for llvmpipe").
   int lo = 0, hi = h - 1;
   if (lo < hi) do {
     int mid = (lo + hi) / 2;

@@ -49,7 +49,7 @@ float sheenVisibility(float cosO, float cosI, float alpha) {
 }
 
 // Directional albedo E(cos theta_o, roughness) of the white Charlie BRDF: bilinear in (sqrt(mu),
-// roughness) over the table (scripts/make_sheen_albedo.py). At grazing angles and roughness below ~0.25
+// roughness) over the table (scripts/make-sheen-albedo). At grazing angles and roughness below ~0.25
 // it exceeds 1 (the BRDF as the extension defines it reflects more than it receives there).
 float sheenAlbedo(float cosTheta, float roughness) {
   const int nMu = CAUSTICA_SHEEN_ALBEDO_MU, nR = CAUSTICA_SHEEN_ALBEDO_ROUGHNESS;

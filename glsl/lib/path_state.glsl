@@ -59,7 +59,8 @@ bool nextRayTraced(PathState s) { return s.depth + 1u < frame.options.x; }
 // (inside glass that factor is not an energy loss and must not end paths; pbrt-v4 does the same),
 // times the dispersion filter: after a dispersive event the path carries s.filt (3 in one channel,
 // or the hero wavelength's sensitivity / pdf), and ignoring it ended those paths up to 3x too
-// often (cornell-dispersion 64x64: 1.3-2.1x the efficiency; docs/benchmarks.md). False: the path ends.
+// often (cornell-dispersion 64x64: 1.3-2.1x the efficiency; docs/path-tracer.md, "Chromatic aberration").
+// False: the path ends.
 bool russianRoulette(inout PathState s) {
   if (s.depth >= 3u) {
     float q = min(maxComponent(s.beta * s.filt) * s.etaScale, 1.0);

@@ -27,7 +27,7 @@
 // way. A popped subtree beyond the closest hit so far is not skipped on the stack: its node visit
 // enters none of its children (their boxes end before hit.t), so no distances are stacked. The stack's
 // top eight refs are kept in registers and the inner loop never indexes the local array (see
-// BVH_INNER_STEP; docs/benchmarks.md, "Session 6").
+// BVH_INNER_STEP; docs/architecture.md, "Traversal").
 
 struct Hit {
   float t;   // distance along dir (units of |dir|)
@@ -160,7 +160,7 @@ bool traceOccluded(vec3 org, vec3 dir, float tmax) {
 // bottom four registers to the array and the node is visited again. The array is read only when the
 // registers are empty, also in the outer loop. One stack (LIFO) all the same: the same order of visits
 // as the C++ twin's. Both are rare (measured on five bundled scenes: at most 0.001 overflows and 0.004 array
-// pops per ray, docs/benchmarks.md "Session 6"), but each array access site costs on every pass of its loop.
+// pops per ray, docs/architecture.md "Traversal"), but each array access site costs on every pass of its loop.
 
 // Pushes r.y, r.z, r.w (the first k, 0..3; r.y on top) onto the register stack (a, b).
 void bvhRegPush(inout uvec4 a, inout uvec4 b, uvec4 r, uint k) {
@@ -236,13 +236,13 @@ bool traceClosest(vec3 org, vec3 dir, float tmax, out Hit hit) {
 
   // Refs only, as in traceOccluded: a popped subtree is entered even when its entry distance is beyond
   // the closest hit (bvhVisitWide then enters none of its children, or its leaf's triangles fail the
-  // t < hit.t test), so the hit is the same (docs/benchmarks.md, Session 5, part 4).
+  // t < hit.t test), so the hit is the same (docs/architecture.md, "Traversal").
   BVH_STACK_VARS
   uint ref = 0u;  // the root, an inner node
   while (true) {
     // Inner nodes until this lane holds a leaf (or the empty leaf: see BVH_INNER_STEP).
     // Both loops test at the bottom: on llvmpipe a top-tested loop runs one masked body more than its
-    // trip count when its last lane leaves (docs/architecture.md, llvmpipe note; session 7: 1.15-1.24x).
+    // trip count when its last lane leaves (docs/architecture.md, "Writing shaders for llvmpipe": 1.15-1.24x).
     if ((ref & kBvhLeafBit) == 0u) do {
       uvec4 r;
       vec4 t;

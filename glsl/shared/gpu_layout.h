@@ -39,7 +39,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_TEXUNIT_TRI_GEOM 3    // texture unit: buffer texture (rgba32ui) over the TriGeom buffer, 3 texels per triangle
 #define CAUSTICA_TEXUNIT_BVH_WIDE 6    // texture unit: buffer texture (rgba32ui) over the BvhWideNode buffer, 7 texels per node
 // The shading reads go through buffer textures too (app/gpu/shading_textures.*): on llvmpipe a texelFetch
-// is a vector gather, an SSBO load a loop over the SIMD lanes (docs/benchmarks.md, "Session 5").
+// is a vector gather, an SSBO load a loop over the SIMD lanes (docs/architecture.md, "Writing shaders for llvmpipe").
 #define CAUSTICA_TEXUNIT_MATERIALS 4   // texture unit: buffer texture (rgba32ui) over the materials buffer, 12 texels per Material
 #define CAUSTICA_TEXUNIT_LIGHT_NODES 5 // texture unit: buffer texture (rgba32ui) over the light-tree buffer, 4 texels per LightNode
 #define CAUSTICA_TEXUNIT_TEXELS 7      // texture unit: buffer texture (r32ui) over the texel buffer, one word per texel

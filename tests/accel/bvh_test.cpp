@@ -656,9 +656,9 @@ std::vector<Triangle> bumpySphere(int nu, int nv) {
 
 }  // namespace
 
-TEST_CASE("bvh: SAH cost not above the session-3 builder's, and its bunny tree bit for bit") {
+TEST_CASE("bvh: SAH cost not above the previous builder's, and its bunny tree bit for bit") {
   // Bounds: the SAH costs (bvhSahCost, relative to the root's area) of the builder this one replaced
-  // (session 3, main 02c1bf0), measured with 16 bins. A tree 0.01 % worse fails. The bunny's tree
+  // (main 02c1bf0), measured with 16 bins. A tree 0.01 % worse fails. The bunny's tree
   // (nodes and leaf order) is also that builder's bit for bit, so images did not change.
   const std::vector<Triangle> bunny = loadBunny();
   const std::vector<Triangle> sphere = bumpySphere(256, 160);  // 81,408 triangles: the threaded build
@@ -680,7 +680,7 @@ TEST_CASE("bvh: SAH cost not above the session-3 builder's, and its bunny tree b
     CHECK(std::fabs(double(bvh.sahCost) - sah) <= 1e-6 * sah);
   }
   // One build with 16 bins (the default adds a 32-bin build for small meshes and keeps the lower SAH
-  // cost: session 7; the bounds above hold all the more).
+  // cost: docs/architecture.md, "BVH build"; the bounds above hold all the more).
   BvhBuildOptions once;
   once.secondBins = 0;
   CHECK(treeHash(buildBvh(bunny, once)) == 0x46c7250bd0fc3859ull);

@@ -71,7 +71,7 @@ TEST_CASE("checkpoint: round trip keeps every float bit and header field") {
   CHECK(b.state.comp == a.state.comp);
   CHECK(b.state.half == a.state.half);
   CHECK(b.state.coverage.empty());  // an opaque render has no coverage image
-  CHECK(slurp(path).rfind("CAUSTICA-CKPT 4\n", 0) == 0);
+  CHECK(slurp(path).rfind("CAUSTICA-CKPT 5\n", 0) == 0);
   CHECK(checkpointMismatch(b, 0x0123456789abcdefull, a.identity).empty());
 }
 
@@ -96,11 +96,11 @@ TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; o
   // the file and what to do.
   writeCheckpoint(path, sample(3, 2, 1.5f));
   std::string v3 = slurp(path);
-  v3.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 3");
+  v3.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 3");
   spit(path, v3);
   CHECK_THROWS_WITH_AS(readCheckpoint(path),
                        doctest::Contains("coverage.ckpt: not a usable caustica checkpoint: version 3 (this caustica "
-                                         "reads version 4, whose settings name every option that changes the image; "
+                                         "reads versions 4 to 5, whose settings name every option that changes the image; "
                                          "render again to write one)"),
                        Error);
 }
@@ -119,13 +119,13 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
   // A version-1 file (no half image: no error estimate to resume adaptive sampling from) is refused.
   std::string v1 = good;
-  v1.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 1");
+  v1.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 1");
   spit(path, v1);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads version 4"), Error);
-  std::string v5 = good;
-  v5.replace(0, std::string("CAUSTICA-CKPT 4").size(), "CAUSTICA-CKPT 5");
-  spit(path, v5);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 5 (this caustica reads version 4)"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 4 to 5"), Error);
+  std::string v6 = good;
+  v6.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 6");
+  spit(path, v6);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 6 (this caustica reads versions 4 to 5)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);

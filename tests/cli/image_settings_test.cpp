@@ -23,6 +23,7 @@ namespace {
 void perturb(int& v) { v += 1; }
 void perturb(std::uint32_t& v) { v += 1; }
 void perturb(float& v) { v += 0.125f; }
+void perturb(double& v) { v += 0.125; }
 void perturb(bool& v) { v = !v; }
 void perturb(std::string& v) { v += "x"; }
 template <class E, std::enable_if_t<std::is_enum_v<E>, int> = 0>
@@ -128,8 +129,8 @@ TEST_CASE("image settings: every field is read from its option") {
   REQUIRE(opts.parse({"--size", "64x32", "--seed", "5", "--max-depth", "9", "--integrator", "naive", "--dispersion",
                       "spectral", "--caster-probability", "0.25", "--mode", "whitted", "--all-features",
                       "--samples-per-dispatch", "2", "--env", "0.5", "--env-strength", "2", "--env-rotation", "30",
-                      "--background", "0.2,0.2,0.2", "--light-radius", "0.05", "--camera", "1", "--exposure", "1.5",
-                      "--tonemap", "clamp"}));
+                      "--background", "0.2,0.2,0.2", "--light-radius", "0.05", "--animation", "spin", "--anim-time", "1.5",
+                      "--camera", "1", "--exposure", "1.5", "--tonemap", "clamp"}));
   const ImageSettings got = imageSettingsFrom(opts, Camera{}, 512), defaults;
   // Every field differs from its default: an option that is listed but not read stays at the default.
   std::vector<std::string> a, b, names;
@@ -145,7 +146,12 @@ TEST_CASE("image settings: every field is read from its option") {
   }
   CHECK(settingsSummary(got).find("width 64, height 32, seed 5") == 0);
   CHECK(accumulationIdentity(got, Camera{}).find("env 0.5\nenv-strength 2\nenv-rotation 30\nbackground 0.2,0.2,0.2\n"
-                                                 "light-radius 0.05\ncamera 1\n") != std::string::npos);
+                                                 "light-radius 0.05\nanimation spin\nanim-time 1.5\ncamera 1\n") !=
+        std::string::npos);
+  // --frame N with --fps F is the time N / F.
+  Options frame("test", "", sceneOptionSpecs());
+  REQUIRE(frame.parse({"--frame", "12", "--fps", "8"}));
+  CHECK(imageSettingsFrom(frame, Camera{}, 512).scene.animTime == 1.5);
 
   Options bad("test", "", sceneOptionSpecs());
   REQUIRE(bad.parse({"--light-radius", "-1"}));

@@ -35,7 +35,7 @@ if(EXISTS ${OUT}.ckpt.tmp)
   message(FATAL_ERROR "a temporary checkpoint was left behind")
 endif()
 file(READ ${OUT}.ckpt head LIMIT 200)
-if(NOT head MATCHES "^CAUSTICA-CKPT 4\nwidth 16\nheight 16\nspp ${reached}\n")
+if(NOT head MATCHES "^CAUSTICA-CKPT 5\nwidth 16\nheight 16\nspp ${reached}\n")
   message(FATAL_ERROR "the checkpoint does not hold the ${reached} spp reached: ${head}")
 endif()
 # The Cornell box's mean radiance at 16x16 is about 0.3-0.4: non-black and finite.

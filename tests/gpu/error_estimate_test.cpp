@@ -119,7 +119,7 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
 
 }  // namespace
 
-// The figures of docs/benchmarks.md ("Error estimate"): every bundled scene, 32x32, at 128, 256 and
+// The figures of docs/adaptive-sampling.md ("How good the estimate is"): every bundled scene, 32x32, at 128, 256 and
 // 512 spp, the estimate within 25 % of the measured relMSE, both averaged over 8 seeds (each line's
 // single runs are printed). Measured offline (llvmpipe, 8 seeds, 4096-spp reference; ratios at 8 /
 // 32 / 128 / 512 spp): cornell-glass 1.59 / 0.96 / 1.03 / 0.96, cornell-dispersion 1.18 / 1.20 /

@@ -38,7 +38,7 @@ TEST_CASE("casters of the bundled scenes: the glass and mirror spheres, nothing 
   std::vector<CausticCaster> c = findCausticCasters(glass, CAUSTICA_MAX_CASTERS);
   REQUIRE(c.size() == 2);
   for (const auto& k : c) {
-    CHECK(k.sphere.w == doctest::Approx(0.35).epsilon(0.02));  // both spheres have radius 0.35 (make_assets.py)
+    CHECK(k.sphere.w == doctest::Approx(0.35).epsilon(0.02));  // both spheres have radius 0.35 (scripts/make-assets)
     CHECK(k.sphere.y == doctest::Approx(k.sphere.w).epsilon(0.02));  // resting on the floor
   }
   CHECK(c[0].refractive != c[1].refractive);  // one glass, one mirror

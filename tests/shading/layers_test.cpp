@@ -34,7 +34,7 @@ double lambdaD(double cosTheta, double alpha) {
 }
 
 // E(mu, r) = integral of D V cos(theta_i) over the hemisphere, by the midpoint rule in (sqrt(cos theta_i),
-// phi): an independent check of scripts/make_sheen_albedo.py (other grid, other language).
+// phi): an independent check of scripts/make-sheen-albedo (other grid, other language).
 double albedoQuadrature(double mu, double roughness, int nT = 160, int nPhi = 64) {
   const double alpha = roughness * roughness, inv = 1.0 / alpha;
   const double sinO = std::sqrt(std::max(0.0, 1.0 - mu * mu)), lamO = lambdaD(mu, alpha);

@@ -197,23 +197,6 @@ std::string formatDouble(const char* printfFormat, double value) {
 
 std::string formatSci(double value) { return std::isfinite(value) ? formatDouble("%.3g", value) : "n/a"; }
 
-std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t hash) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= p[i];
-    hash *= 0x100000001b3ull;
-  }
-  return hash;
-}
-
-std::uint64_t fnv1a64(const std::string& text, std::uint64_t hash) { return fnv1a64(text.data(), text.size(), hash); }
-
-std::string hex64(std::uint64_t value) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(value));
-  return buf;
-}
-
 std::map<std::string, BenchSceneInfo> parseBenchScenes(const std::string& jsonText, const std::string& fileName) {
   nlohmann::json j;
   try {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "image/image_io.h"
+#include "util/hash.h"  // fnv1a64, hex64 (the bench's reference cache keys)
 
 namespace caustica {
 
@@ -89,12 +90,6 @@ int nextBatchSpp(int sppSoFar, double elapsedSeconds, double targetSeconds, doub
 std::string formatDouble(const char* printfFormat, double value);
 // Three significant digits ("0.0259", "1.23e+06"); "n/a" when not finite.
 std::string formatSci(double value);
-
-// FNV-1a, 64-bit. Chain calls by passing the previous hash as `hash`.
-constexpr std::uint64_t kFnv1a64Offset = 0xcbf29ce484222325ull;
-std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t hash = kFnv1a64Offset);
-std::uint64_t fnv1a64(const std::string& text, std::uint64_t hash = kFnv1a64Offset);
-std::string hex64(std::uint64_t value);  // 16 lower-case hex digits
 
 // One entry of bench/scenes.json.
 struct BenchSceneInfo {

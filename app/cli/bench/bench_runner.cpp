@@ -198,7 +198,7 @@ class BenchRunner {
     auto tiles = [&](int tile) { return tileRelVariance(st.accum, st.comp, st.half, ref.image, tile); };
     const std::vector<double> v4 = tiles(4);
     {  // per pixel (row-major): the per-sample relative variance, reference-weighted, from the halves, for
-       // analyses across renders (scripts/adaptive-ceiling; docs/benchmarks.md, "Adaptive sampling")
+       // analyses across renders (bench/experiments/adaptive-ceiling; docs/adaptive-sampling.md, "How much it can gain")
       std::ofstream f(outDir_ + "/" + name + "-" + dispersionModeName(mode) + "-pixel-variance.txt");
       f << "# " << ref.image.width << "x" << ref.image.height << " pixels, row-major: per-sample relative variance "
         << "from the halves (uniform render, seed " << run.seed << ", " << spp << " spp)\n";
@@ -211,7 +211,8 @@ class BenchRunner {
     // The allocation adaptive sampling itself makes (AdaptiveSampler, this tile size and guards, another
     // seed: independent of the variances), run to a mean of min(spp01, spp) samples per pixel; its
     // expected relMSE mean(v / n) against uniform sampling's mean(v) / mean(n). Free of a single run's
-    // luck, which favours adaptive sampling where noise is heavy-tailed (docs/benchmarks.md).
+    // luck, which favours adaptive sampling where noise is heavy-tailed (docs/adaptive-sampling.md, "How much
+    // it can gain").
     AdaptiveSampler sampler(0.0, true);
     const std::vector<double> vt = sampler.tileSize() == 4 ? v4 : tiles(sampler.tileSize());  // v4 at the default
     RenderSettings other = run;

@@ -89,3 +89,13 @@ add_test(NAME "bench: smoke run writes CSV, plot and summary, then reuses the ca
                  -DGNUPLOT=${CAUSTICA_GNUPLOT} -P ${CMAKE_CURRENT_LIST_FILE})
 set_tests_properties("bench: smoke run writes CSV, plot and summary, then reuses the cached reference"
                      PROPERTIES ENVIRONMENT "LP_NUM_THREADS=2" TIMEOUT 120)
+
+# bench/run-all, the command behind docs/benchmarks.md, end to end on one tiny scene (run_all_smoke.cmake).
+find_package(Python3 COMPONENTS Interpreter)
+if(Python3_Interpreter_FOUND)
+  add_test(NAME "bench: run-all --smoke fills every region of docs/benchmarks.md"
+           COMMAND ${CMAKE_COMMAND} -DPYTHON=${Python3_EXECUTABLE} -DSRC=${CMAKE_SOURCE_DIR} -DCLI=$<TARGET_FILE:caustica>
+                   -DOUT=${CMAKE_CURRENT_BINARY_DIR}/run_all_smoke -P ${CMAKE_CURRENT_LIST_DIR}/run_all_smoke.cmake)
+  set_tests_properties("bench: run-all --smoke fills every region of docs/benchmarks.md"
+                       PROPERTIES ENVIRONMENT "LP_NUM_THREADS=2" TIMEOUT 300)
+endif()
