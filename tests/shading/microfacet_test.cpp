@@ -135,7 +135,7 @@ TEST_CASE("GGX visible normals: chi-square against G1 max(0, wo.h) D / wo.z") {
     }
 }
 
-TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe and the sheen") {
+TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe, the clear coat and the sheen") {
   Bsdf metal;
   metal.lobe = kLobeConductor;
   metal.color = glm::vec3(0.9f, 0.6f, 0.3f);
@@ -150,11 +150,14 @@ TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe and the she
   Bsdf sheen;
   sheen.lobe = kLobeSheen;
   sheen.color = glm::vec3(1.0f, 0.5f, 0.2f);
-  const char* names[] = {"rough metal", "plastic", "rough glass entering", "rough glass leaving", "sheen"};
+  Bsdf coat;  // the clear coat's lobe: a white GGX reflection (F = 1) about the coat normal (layers.glsl)
+  coat.lobe = kLobeConductor;
+  coat.color = glm::vec3(1.0f);
+  const char* names[] = {"rough metal", "plastic", "rough glass entering", "rough glass leaving", "sheen", "clear coat"};
   for (float alpha : {0.3f, 0.7f})
     for (float cosO : {0.9f, 0.3f})
-      for (int k = 0; k < 5; ++k) {
-        Bsdf b = k == 0 ? metal : k == 1 ? plastic : k == 4 ? sheen : glass;
+      for (int k = 0; k < 6; ++k) {
+        Bsdf b = k == 0 ? metal : k == 1 ? plastic : k == 4 ? sheen : k == 5 ? coat : glass;
         b.alpha = alpha;
         if (k == 3) b.eta = 1.0f / 1.5f;  // leaving glass: total internal reflection beyond ~42 degrees
         CAPTURE(alpha);
