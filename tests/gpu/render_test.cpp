@@ -809,6 +809,61 @@ TEST_CASE("ClearCoatTest: a black base under only a clear coat shows the coat's 
   }
 }
 
+// The textures of KHR_materials_specular (specularTexture A, specularColorTexture RGB) and
+// KHR_materials_transmission (transmissionTexture R) scale their factors per hit: a material whose
+// textures hold the value 128 (linear 128 / 255; the colour texture white) renders what the same material
+// with the factor 128 / 255 written out renders, sample for sample (same lobe picks, same weights; only
+// float rounding of F0 differs), and differently from the factor alone (the textures are not ignored).
+TEST_CASE("specular and transmission textures scale their factors as the factors would") {
+  const float half = 128.0f / 255.0f;
+  for (int kind = 0; kind < 2; ++kind) {
+    Scene s;
+    Texture t;
+    t.width = t.height = 1;
+    t.rgba = kind == 0 ? std::vector<std::uint8_t>{255, 255, 255, 128} : std::vector<std::uint8_t>{128, 0, 0, 255};
+    s.textures.push_back(t);
+    Material textured = diffuseMaterial(glm::vec3(0.6f, 0.3f, 0.1f));
+    textured.roughness = 0.4f;
+    textured.specularF0 = glm::vec3(0.04f);
+    textured.specularF90 = 1.0f;
+    Material factor = textured;
+    if (kind == 0) {  // the plastic lobe: F0 = 0.04 x A, F90 = A
+      textured.specularTexture = textured.specularColorTexture = 0;
+      factor.specularF0 = glm::vec3(0.04f * half);
+      factor.specularF90 = half;
+    } else {  // rough glass of weight transmission x R
+      textured.transmission = 1.0f;
+      textured.transmissionTexture = 0;
+      factor.transmission = half;
+    }
+    Material untextured = textured;
+    untextured.specularTexture = untextured.specularColorTexture = untextured.transmissionTexture = -1;
+    const Material light = emitterMaterial(4.0f);
+    auto render = [&](const Material& m) {
+      Scene scene = s;
+      scene.materials = {m, light};
+      addQuad(scene, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, 0);
+      addQuad(scene, {-0.5f, 1.0f, -0.5f}, {0.5f, 1.0f, -0.5f}, {0.5f, 1.0f, 0.5f}, {-0.5f, 1.0f, 0.5f}, 1);
+      scene.texcoords.assign(scene.triangles.size(), TriangleUv{});
+      finishBounds(scene);
+      const Camera cam = lookAt({0.0f, 1.6f, 1.6f}, {0.0f, 0.0f, -0.3f}, 0.9f);
+      return renderScene(scene, cam, smallSettings(24, 24, Integrator::Mis, 3), 16);
+    };
+    const RenderResult a = render(textured), b = render(factor), c = render(untextured);
+    CHECK(hasDefine(a.defines, "CAUSTICA_FACTOR_TEXTURES"));
+    CHECK_FALSE(hasDefine(b.defines, "CAUSTICA_FACTOR_TEXTURES"));
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.image.rgb.size(); ++i)
+      worst = std::max(worst, double(std::abs(a.image.rgb[i] - b.image.rgb[i])) / (1e-3 + double(b.image.rgb[i])));
+    const double ma = meanOf(a.image), mb = meanOf(b.image), mc = meanOf(c.image);
+    const std::string what = kind == 0 ? "specular texture" : "transmission texture";
+    INFO(what, ": mean ", ma, ", factor ", mb, ", texture ignored ",
+         mc, "; worst pixel ", worst);
+    CHECK(worst < 1e-3);
+    CHECK(std::abs(mc / mb - 1.0) > 0.02);
+  }
+}
+
 // One layered material filling the view under a square light, at depth 2 (direct light only): the coat's
 // and the sheen's light sampling (vertexEval, vertexPdf about the coat's own normal) against pure BSDF
 // sampling, per region; the whole image must be sharp enough to fail a 0.5 % bias. The last case lights a
