@@ -29,6 +29,9 @@
 #include "lib/coverage.glsl"
 #endif
 #include "lib/adaptive.glsl"
+#ifdef CAUSTICA_AOV
+#include "lib/feature_buffers.glsl"
+#endif
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
 
@@ -49,8 +52,14 @@ bool pathBounce(inout PathState s) {
   Hit hit;
   if (!traceClosest(s.org, s.dir, 3.0e38, hit)) {
     addEscaped(s);  // path_emission.glsl: the environment
+#ifdef CAUSTICA_AOV
+    featuresRecord(s.feat, vec3(1.0), vec3(0.0), true);  // the sky: no surface (feature_buffers.glsl)
+#endif
     return false;
   }
+#ifdef CAUSTICA_AOV
+  featuresTravel(s.feat, hit.t);
+#endif
 #ifdef CAUSTICA_VOLUME
   s.beta *= exp(-s.sigma * hit.t);  // absorbed along the segment
 #endif
@@ -62,6 +71,11 @@ bool pathBounce(inout PathState s) {
 #endif
   addEmission(s, sf);                           // path_emission.glsl: with its MIS weight
   BounceLobe lobe = chooseBounceLobe(s, sf, base.rgb);  // path_scatter.glsl
+#ifdef CAUSTICA_AOV
+  // The first non-specular hit, or an emitter (albedo 1: its radiance is not divided by a colour).
+  if (surfaceEmits(sf) || isDiffuseLobe(lobe) || isGlossyLobe(lobe))
+    featuresRecord(s.feat, surfaceEmits(sf) ? vec3(1.0) : lobe.color, sf.ns, false);
+#endif
   vec3 newDir;
   if (isDiffuseLobe(lobe) || isGlossyLobe(lobe)) {
 #ifdef CAUSTICA_CASTERS
@@ -93,6 +107,9 @@ void main() {
     uint samples = max(frame.options.w, 1u);
     uint maxDepth = frame.options.x;
     PixelSums sums = loadPixelSums(ivec2(pixel));  // accumulate.glsl
+#ifdef CAUSTICA_AOV
+    FeatureSums features = loadFeatureSums(ivec2(pixel));  // feature_buffers.glsl
+#endif
 #ifdef CAUSTICA_TRANSPARENT
     float covered = loadCoverage(ivec2(pixel));  // coverage.glsl
 #endif
@@ -104,6 +121,9 @@ void main() {
       bool finite = !(any(isnan(l)) || any(isinf(l)));
       if (!finite) ++bad;  // counted and reported; not part of the pixel's mean (neither as black)
       addSample(sums, finite ? l : vec3(0.0), finite ? 1.0 : 0.0);
+#ifdef CAUSTICA_AOV
+      if (finite) addFeatureSample(features, path.feat, l);
+#endif
 #ifdef CAUSTICA_TRANSPARENT
       covered += finite && !gCameraRayMissed ? 1.0 : 0.0;
 #endif
@@ -112,6 +132,9 @@ void main() {
     }
     primary = samples;
     storePixelSums(ivec2(pixel), sums);
+#ifdef CAUSTICA_AOV
+    storeFeatureSums(ivec2(pixel), features);
+#endif
 #ifdef CAUSTICA_TRANSPARENT
     storeCoverage(ivec2(pixel), covered);
 #endif

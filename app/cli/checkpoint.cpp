@@ -1,6 +1,7 @@
 // checkpoint.cpp — checkpoint file format: a text header after the magic line, then the three images'
-// raw floats (sums, Kahan compensation, odd-sample half) and, with "coverage 1", the coverage image's
-// (native little-endian), protected by an FNV-1a 64 checksum.
+// raw floats (sums, Kahan compensation, odd-sample half), with "coverage 1" the coverage image's and with
+// "features 1" (version 6) the two feature-sum images' (native little-endian), protected by an FNV-1a 64
+// checksum.
 #include "cli/checkpoint.h"
 
 #include <cerrno>
@@ -22,7 +23,12 @@ std::uint64_t dataHash(const AccumulationState& st) {
   std::uint64_t h = fnv1a64(st.accum.data(), st.accum.size() * sizeof(float));
   h = fnv1a64(st.comp.data(), st.comp.size() * sizeof(float), h);
   h = fnv1a64(st.half.data(), st.half.size() * sizeof(float), h);
-  return st.coverage.empty() ? h : fnv1a64(st.coverage.data(), st.coverage.size() * sizeof(float), h);
+  if (!st.coverage.empty()) h = fnv1a64(st.coverage.data(), st.coverage.size() * sizeof(float), h);
+  if (st.hasFeatures()) {
+    h = fnv1a64(st.albedo.data(), st.albedo.size() * sizeof(float), h);
+    h = fnv1a64(st.normal.data(), st.normal.size() * sizeof(float), h);
+  }
+  return h;
 }
 
 std::map<std::string, std::string> parseLines(const std::string& text) {
@@ -41,16 +47,18 @@ std::map<std::string, std::string> parseLines(const std::string& text) {
 void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
   const AccumulationState& st = ck.state;
   const size_t n = static_cast<size_t>(st.width) * st.height * 4;
-  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n || (!st.coverage.empty() && st.coverage.size() != n / 4))
+  if (st.accum.size() != n || st.comp.size() != n || st.half.size() != n || (!st.coverage.empty() && st.coverage.size() != n / 4) ||
+      (st.hasFeatures() && (st.albedo.size() != n || st.normal.size() != n)))
     throw Error("internal: checkpoint images do not match its size");
   std::ostringstream h;
-  h << kCheckpointMagic << ' ' << kCheckpointVersion << '\n'
+  h << kCheckpointMagic << ' ' << (st.hasFeatures() ? kCheckpointVersion : kCheckpointVersionWithoutFeatures) << '\n'
     << "width " << st.width << '\n'
     << "height " << st.height << '\n'
     << "spp " << st.spp << '\n'
     << "sample-base " << st.sampleBase << '\n'
-    << "coverage " << (st.coverage.empty() ? 0 : 1) << '\n'
-    << "seed " << ck.seed << '\n';
+    << "coverage " << (st.coverage.empty() ? 0 : 1) << '\n';
+  if (st.hasFeatures()) h << "features 1\n";
+  h << "seed " << ck.seed << '\n';
   if (ck.shard)
     h << "shard " << ck.shard->index << '/' << ck.shard->count << ' ' << ck.shard->first << ' ' << ck.shard->end << ' '
       << ck.shard->total << '\n';
@@ -67,6 +75,8 @@ void writeCheckpoint(const std::string& path, const Checkpoint& ck) {
     out.write(reinterpret_cast<const char*>(st.comp.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.half.data()), static_cast<std::streamsize>(n * sizeof(float)));
     out.write(reinterpret_cast<const char*>(st.coverage.data()), static_cast<std::streamsize>(st.coverage.size() * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(st.albedo.data()), static_cast<std::streamsize>(st.albedo.size() * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(st.normal.data()), static_cast<std::streamsize>(st.normal.size() * sizeof(float)));
     out.close();
     if (!out) throw Error(tmp + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
   });
@@ -101,6 +111,7 @@ Checkpoint readCheckpoint(const std::string& path) {
                                                   : "") +
               ")");
   const bool coverage = num("coverage") != 0;
+  const bool features = head.count("features") != 0 && num("features") != 0;  // version 6
   Checkpoint ck;
   AccumulationState& st = ck.state;
   unsigned long long w = num("width"), hgt = num("height"), settingsBytes = num("settings");
@@ -134,7 +145,7 @@ Checkpoint readCheckpoint(const std::string& path) {
   ck.identity = bytes.substr(settingsLineEnd + 1, settingsBytes);
   const size_t dataAt = end + 5;
   const size_t n = static_cast<size_t>(w) * hgt * 4;
-  const size_t dataBytes = (3 * n + (coverage ? n / 4 : 0)) * sizeof(float);
+  const size_t dataBytes = (3 * n + (coverage ? n / 4 : 0) + (features ? 2 * n : 0)) * sizeof(float);
   if (bytes.size() != dataAt + dataBytes)
     throw bad("holds " + std::to_string(bytes.size() - dataAt) + " bytes of image data, expected " +
               std::to_string(dataBytes) + " (truncated?)");
@@ -147,6 +158,13 @@ Checkpoint readCheckpoint(const std::string& path) {
   if (coverage) {
     st.coverage.resize(n / 4);
     std::memcpy(st.coverage.data(), bytes.data() + dataAt + 3 * n * sizeof(float), n / 4 * sizeof(float));
+  }
+  if (features) {
+    const size_t at = dataAt + (3 * n + (coverage ? n / 4 : 0)) * sizeof(float);
+    st.albedo.resize(n);
+    st.normal.resize(n);
+    std::memcpy(st.albedo.data(), bytes.data() + at, n * sizeof(float));
+    std::memcpy(st.normal.data(), bytes.data() + at + n * sizeof(float), n * sizeof(float));
   }
   if (dataHash(st) != expected) throw bad("the image data fails its checksum (corrupted)");
   return ck;

@@ -26,7 +26,10 @@ constexpr const char* kCheckpointMagic = "CAUSTICA-CKPT";
 // "key value" a line); older files are refused, naming the file: their settings text lacks fields.
 // 5: adds an optional "shard K/N FIRST END TOTAL" line: the file is the partial of a shard (render
 // --shard, cli/shard.h). Version 4 files read as version 5 files without it.
-constexpr int kCheckpointVersion = 5;
+// 6: adds a "features 1" header line and the denoiser's two rgba32f feature-sum images after the others
+// (render --denoise, --aov; docs/denoising.md). A render without feature buffers still writes version 5.
+constexpr int kCheckpointVersion = 6;
+constexpr int kCheckpointVersionWithoutFeatures = 5;
 constexpr int kCheckpointOldestVersion = 4;
 
 // The share of one shard of a render (render --shard K/N): the global sample indices [first, end) of a
@@ -41,7 +44,7 @@ struct SampleShare {
 };
 
 struct Checkpoint {
-  AccumulationState state;        // the three rgba32f images (+ coverage), spp and the next global sample index
+  AccumulationState state;        // the three rgba32f images (+ coverage, + feature sums), spp and the next global sample index
   std::uint32_t seed = 0;
   std::uint64_t sceneHash = 0;    // hashSceneFiles of the scene file(s)
   std::string identity;           // accumulationIdentity(settings, camera) of the render

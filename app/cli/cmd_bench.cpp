@@ -30,6 +30,9 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--scenes-json", "", "FILE", "caustic regions per scene (default: the bundled bench/scenes.json)"},
       {"--gnuplot", "", "PROG", "gnuplot program that draws the plots (default gnuplot)"},
       {"--seed", "", "S", "random seed of the measured runs (default 1); the reference uses another"},
+      {"--denoise", "", "",
+       "also measure the denoiser: a denoised mis run (its filter on the clock), and raw against denoised at 4, 16, 64, "
+       "256 spp (OUT/denoise.csv, bench-denoise-SCENE.png plots and -pictures.png figures, a summary table; docs/denoising.md)"},
       sceneOptionSpec("--max-depth"),
       sceneOptionSpec("--caster-probability"),
       sceneOptionSpec("--camera"),

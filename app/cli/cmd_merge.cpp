@@ -1,12 +1,15 @@
 // cmd_merge.cpp — `caustica merge`: adds the partials of a render's shards (render --shard K/N) into
 // the image one machine would have rendered (docs/render-farm.md). Needs no GPU.
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 
+#include "cli/aov_output.h"
 #include "cli/checkpoint.h"
 #include "cli/cli_common.h"
 #include "cli/commands.h"
 #include "cli/shard.h"
+#include "image/denoise.h"
 #include "image/error_estimate.h"
 #include "image/image_io.h"
 #include "util/error.h"
@@ -21,6 +24,11 @@ int cmdMerge(const std::vector<std::string>& args) {
       {"--partial", "", "",
        "merge the parts there are even if samples are missing (shards not given or not finished): the image of "
        "the samples held, each pixel the mean of its own samples"},
+      {"--denoise", "", "",
+       "write the denoised image of the merged samples (docs/denoising.md): the shards must have been rendered with "
+       "--denoise or --aov (their partials then hold the feature sums); the denoiser's C++ twin runs on the CPU"},
+      {"--aov", "", "LIST",
+       "also write albedo, normal, depth, variance, raw (or all) of the merged samples, as render --aov does"},
       {"--exposure", "", "STOPS", "PNG exposure in stops (default 0)"},
       {"--tonemap", "", "CURVE", "PNG tone curve: aces (default) or clamp"},
       {"--quiet", "-q", "", "print nothing but errors"},
@@ -42,7 +50,12 @@ int cmdMerge(const std::vector<std::string>& args) {
   tone.exposureStops = static_cast<float>(opts.getDouble("--exposure", tone.exposureStops));
   tone.curve = parseToneCurve(opts.get("--tonemap", toneCurveName(tone.curve)));
   if (opts.positional().empty()) throw Error("no parts given: caustica merge PART... -o OUTPUT");
+  const bool denoise = opts.has("--denoise");
+  const std::vector<Aov> aovs = opts.has("--aov") ? parseAovList(opts.get("--aov", "")) : std::vector<Aov>{};
+  if (toCheckpoint && (denoise || !aovs.empty()))
+    throw Error(out + ": --denoise and --aov write images; a .ckpt output keeps the feature sums for a later render or merge");
   checkWritableFile(out, "output");
+  for (const std::string& f : aovFiles(out, aovs)) checkWritableFile(f, "--aov");
 
   std::vector<MergePart> parts;
   for (const std::string& path : opts.positional()) {
@@ -59,6 +72,10 @@ int cmdMerge(const std::vector<std::string>& args) {
   }
   const MergeResult r = mergeShards(parts, opts.has("--partial"));
   const AccumulationState& st = r.merged.state;
+  if ((denoise || aovsNeedFeatures(aovs)) && !st.hasFeatures())
+    throw Error(parts.front().path + ": the parts hold no feature sums (their shards were rendered without --denoise or "
+                                     "--aov): merge without " + std::string(denoise ? "--denoise" : "--aov") +
+                ", or render the shards with it");
   if (!r.complete()) {
     std::string missing;
     for (const auto& [first, end] : r.missing)
@@ -80,7 +97,20 @@ int cmdMerge(const std::vector<std::string>& args) {
   } else {
     if (!st.coverage.empty() && fileExtension(out) == ".pfm")
       throw Error(out + ": PFM has no alpha channel: write .exr or .png for a render with --background transparent");
-    writeImage(out, meanImage(st.width, st.height, st.accum, st.coverage.empty() ? nullptr : &st.coverage), tone);
+    const std::vector<float>* coverage = st.coverage.empty() ? nullptr : &st.coverage;
+    const Image raw = meanImage(st.width, st.height, st.accum, coverage);
+    if (!denoise) {
+      writeImageWithAovs(out, raw, tone, aovs, raw, st);
+    } else {
+      // The same filter as render --denoise (its GLSL's C++ twin), on the merged sums.
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::vector<float> sums = denoiseSums(DenoiseInput{st.width, st.height, &st.accum, &st.albedo, &st.normal});
+      char ms[64];
+      std::snprintf(ms, sizeof ms, "denoised on the CPU in %.1f ms",
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      note(quiet, ms);
+      writeImageWithAovs(out, meanImage(st.width, st.height, sums, coverage), tone, aovs, raw, st);
+    }
   }
   note(quiet, "wrote " + std::filesystem::absolute(out).string());
   return 0;

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "cli/aov_output.h"
 #include "cli/bench/reference_cache.h"
 #include "cli/budget_render.h"
 #include "cli/checkpoint.h"
@@ -67,6 +68,20 @@ std::function<void()> checkpointWriter(const Renderer& renderer, const std::stri
   };
 }
 
+// Writes the render's image to `out`: the denoised image with `denoise`, else the raw mean, with the
+// AOVs (aov_output.h).
+void writeOutput(Renderer& renderer, const std::string& out, const ToneMapSettings& tone, bool denoise,
+                 const std::vector<Aov>& aovs, bool quiet) {
+  const Image raw = renderer.image();
+  const AccumulationState sums = aovsNeedFeatures(aovs) ? renderer.saveAccumulation() : AccumulationState{};
+  if (!denoise) return writeImageWithAovs(out, raw, tone, aovs, raw, sums);
+  const Image denoised = renderer.denoisedImage();
+  char ms[64];
+  std::snprintf(ms, sizeof ms, "denoised in %.1f ms", renderer.denoiseMs());
+  note(quiet, ms);
+  writeImageWithAovs(out, denoised, tone, aovs, raw, sums);
+}
+
 // What render does besides rendering: stop between passes on Ctrl-C / SIGTERM, and call `checkpoint`
 // every `checkpointSeconds` (0: never) while it renders.
 ProgressHooks renderHooks(double checkpointSeconds, std::function<void()> checkpoint) {
@@ -82,7 +97,7 @@ ProgressHooks renderHooks(double checkpointSeconds, std::function<void()> checkp
 // and the compiled shader variants (Renderer::setScene), and for a rigid animation of an instanced
 // scene the meshes' BVHs (only the instances are placed again; docs/animation.md).
 int renderFrames(const Options& opts, const std::string& pattern, const RenderBudget& budget, Backend backend,
-                 double checkpointSeconds, bool quiet) {
+                 double checkpointSeconds, bool denoise, const std::vector<Aov>& aovs, bool quiet) {
   for (const char* option : {"--shard", "--resume", "--checkpoint-file", "--stats", "--frame"})
     if (opts.has(option))
       throw Error(std::string(option) + " with --frames: render one frame with --frame N for that (a render farm runs a "
@@ -92,6 +107,7 @@ int renderFrames(const Options& opts, const std::string& pattern, const RenderBu
     throw Error(pattern + ": --frames needs the frame number's place in the output name, as #### (e.g. -o out_####.png)");
   checkImageExtension(frameFileName(pattern, first));
   checkWritableFile(frameFileName(pattern, first), "output");
+  for (const std::string& f : aovFiles(frameFileName(pattern, first), aovs)) checkWritableFile(f, "--aov");
   const double fps = opts.getDouble("--fps", 24.0);
   ScenePose pose = scenePoseFrom(opts);  // the animation chosen; the time is each frame's
   if (opts.positional().size() > 1) throw Error("expected one scene, got " + std::to_string(opts.positional().size()));
@@ -127,6 +143,12 @@ int renderFrames(const Options& opts, const std::string& pattern, const RenderBu
       RendererOptions ro;
       ro.sceneUpdates = true;
       renderer = std::make_unique<Renderer>(library, ls.scene, ls.camera, settings, ro);
+      if (denoise || aovsNeedFeatures(aovs)) {
+        if (!renderModeSpec(settings.mode).pathTracer)
+          throw Error(std::string(denoise ? "--denoise" : "--aov") + " needs the path tracer (--mode path), not --mode " +
+                      renderModeName(settings.mode));
+        renderer->setFeatureBuffers(true);
+      }
     } else {
       if (renderer->settings() != settings) renderer->apply(settings);
       renderer->setScene(ls.scene, ls.camera);
@@ -138,7 +160,7 @@ int renderFrames(const Options& opts, const std::string& pattern, const RenderBu
         checkpointWriter(*renderer, checkpointFile, sceneHash, accumulationIdentity(ls.settings, ls.camera), std::nullopt);
     const BudgetResult result = renderWithBudget(*renderer, budget, "frame " + std::to_string(n), quiet,
                                                  renderHooks(checkpointSeconds, saveCheckpoint));
-    writeImage(out, renderer->image(), ls.settings.tone);
+    writeOutput(*renderer, out, ls.settings.tone, denoise, aovs, quiet || n != first);
     if (result.reason == StopReason::Interrupted) {
       std::string saved;
       try {
@@ -199,6 +221,12 @@ int cmdRender(const std::vector<std::string>& args) {
       {"--frames", "", "A..B",
        "render frames A to B of the animation (time N / --fps), one image each, named by -o with #### for the "
        "frame number (out_####.png); reuses what does not change between frames (docs/animation.md)"},
+      {"--denoise", "", "",
+       "write the denoised image instead of the raw mean (docs/denoising.md); with --shard the partial keeps the "
+       "feature sums and caustica merge --denoise denoises the merged render"},
+      {"--aov", "", "LIST",
+       "also write albedo, normal, depth, variance, raw (or all): layers of an .exr output, else files "
+       "OUTPUT-STEM.NAME.pfm (raw: the output's format) beside it; with --shard: caustica merge --aov writes them"},
   };
   for (auto& s : sceneOptionSpecs()) specs.push_back(s);
   Options opts("caustica render [SCENE] [options]",
@@ -253,7 +281,9 @@ int cmdRender(const std::vector<std::string>& args) {
   const double checkpointSeconds = opts.getDouble("--checkpoint", 0.0);
   if (opts.has("--checkpoint") && !(checkpointSeconds > 0.0))
     throw Error("option --checkpoint needs a number of seconds above 0");
-  if (opts.has("--frames")) return renderFrames(opts, out, budget, backend, checkpointSeconds, quiet);
+  const bool denoise = opts.has("--denoise");
+  const std::vector<Aov> aovs = opts.has("--aov") ? parseAovList(opts.get("--aov", "")) : std::vector<Aov>{};
+  if (opts.has("--frames")) return renderFrames(opts, out, budget, backend, checkpointSeconds, denoise, aovs, quiet);
   const std::string checkpointFile = sharded ? out : opts.get("--checkpoint-file", out + ".ckpt");
   std::optional<SampleShare> share;
   if (sharded) {
@@ -263,12 +293,19 @@ int cmdRender(const std::vector<std::string>& args) {
   }
   checkWritableFile(out, "output");
   checkWritableFile(checkpointFile, "checkpoint");
+  if (!share)  // a shard writes its partial only; merge writes the AOVs
+    for (const std::string& f : aovFiles(out, aovs)) checkWritableFile(f, "--aov");
   std::optional<Checkpoint> resumeFrom;
   const bool resumeAuto = opts.get("--resume", "") == "auto";
   const std::string resumePath = resumeAuto ? checkpointFile : opts.get("--resume", "");
   // A bad file fails before any work; with auto, a missing one starts the render (a first run).
   if (opts.has("--resume") && (!resumeAuto || std::filesystem::exists(resumePath))) resumeFrom = readCheckpoint(resumePath);
   else if (resumeAuto) note(quiet, "--resume auto: no " + resumePath + " yet, starting the render");
+  // The feature buffers: for the denoiser and --aov, and kept going when the checkpoint has them.
+  const bool features = denoise || aovsNeedFeatures(aovs) || (resumeFrom && resumeFrom->state.hasFeatures());
+  if (resumeFrom && features && !resumeFrom->state.hasFeatures())
+    throw Error(resumePath + ": has no feature sums (it was rendered without --denoise or --aov): resume it without "
+                "--denoise and --aov, or render again with them");
 
   memTrace("command start");
   const auto commandStart = std::chrono::steady_clock::now();
@@ -279,6 +316,9 @@ int cmdRender(const std::vector<std::string>& args) {
     throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
   const RenderSettings& settings = ls.settings.render;
   const ToneMapSettings& tone = ls.settings.tone;
+  if (features && !renderModeSpec(settings.mode).pathTracer)
+    throw Error(std::string(denoise ? "--denoise" : "--aov") + " needs the path tracer (--mode path), not --mode " +
+                renderModeName(settings.mode));
   flattenForMode(ls.scene, settings.mode, opts, quiet);  // raster draws flat scenes (cli_common.h)
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
@@ -308,6 +348,7 @@ int cmdRender(const std::vector<std::string>& args) {
   ShaderLibrary library = shaderLibraryFrom(opts);
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
+  renderer.setFeatureBuffers(features);
   note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
                   std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
                   renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
@@ -336,7 +377,7 @@ int cmdRender(const std::vector<std::string>& args) {
                 double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
   note(quiet, line);
   note(quiet, loadSummary(renderer, parseSeconds, startToRenderer, ls.scene.triangles.size()));  // load_report.h
-  if (!share) writeImage(out, renderer.image(), tone);
+  if (!share) writeOutput(renderer, out, tone, denoise, aovs, quiet);
   {
     const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);
     note(quiet, "stats " + json);
@@ -368,7 +409,9 @@ int cmdRender(const std::vector<std::string>& args) {
   if (share) {
     saveCheckpoint();
     note(quiet, "wrote " + describeShare(*share) + " of " + std::to_string(spp) + " spp to " +
-                    std::filesystem::absolute(out).string() + " (add the parts with caustica merge)");
+                    std::filesystem::absolute(out).string() +
+                    (features ? " with the feature sums (add the parts with caustica merge; --denoise, --aov there)"
+                              : " (add the parts with caustica merge)"));
     return 0;
   }
   if (checkpointSeconds > 0.0) saveCheckpoint();  // so that the render can be extended later

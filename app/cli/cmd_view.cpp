@@ -15,7 +15,7 @@ namespace caustica::cli {
 int cmdView(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {
       {"--frames", "", "N", "scripted run: render N frames, complete the sample pass in flight, write --screenshot, exit"},
-      {"--screenshot", "", "FILE", "image written at exit: .png (tone-mapped), .exr or .pfm (linear)"},
+      {"--screenshot", "", "FILE", "image written at exit, as shown (denoised unless --no-denoise): .png (tone-mapped), .exr or .pfm (linear)"},
       {"--budget-ms", "", "MS", "path-tracing GPU time per frame in milliseconds (default 30)"},
       {"--spp", "", "N", "stop refining at N samples per pixel (default: never)"},
       {"--target-error", "", "E", "stop refining (and using the GPU) once the estimated relMSE is at most E; key G toggles"},
@@ -24,6 +24,7 @@ int cmdView(const std::vector<std::string>& args) {
       {"--no-vsync", "", "", "do not wait for the display's vertical blank"},
       {"--no-preview", "", "", "always render at full resolution, also while the camera moves"},
       {"--spin", "", "DEG", "orbit the camera DEG degrees per frame (demos, preview benchmarks)"},
+      {"--no-denoise", "", "", "show the raw image, not the denoised one (key N toggles; docs/denoising.md)"},
   };
   for (OptionSpec s : sceneOptionSpecs()) {
     if (s.name == "--backend") continue;  // a window brings its own context
@@ -52,6 +53,7 @@ int cmdView(const std::vector<std::string>& args) {
   config.preview = !opts.has("--no-preview");
   config.spinRadians = opts.getDouble("--spin", 0.0) * 3.14159265358979 / 180.0;
   config.fixedSize = opts.has("--size");
+  config.denoise = !opts.has("--no-denoise");
   Viewer viewer(opts, config);
   return viewer.run();
 #else

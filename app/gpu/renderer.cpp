@@ -9,6 +9,7 @@
 
 #include "accel/bvh_wide.h"
 #include "accel/tlas.h"
+#include "gpu/denoiser.h"
 #include "gpu/raster_renderer.h"
 #include "util/error.h"
 #include "util/hash.h"
@@ -260,7 +261,7 @@ void Renderer::prepareMode() {
 }
 
 std::vector<std::string> Renderer::shaderDefines() const {
-  std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_).defines();  // shader_features.cpp
+  std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_, features_).defines();  // shader_features.cpp
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
@@ -279,6 +280,27 @@ const GlProgram& Renderer::program() {
   ExpandedShader src = library_.expand(entry, defines);
   GlProgram p = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); }, entry);
   return programs_.emplace(key, std::move(p)).first->second;
+}
+
+void Renderer::setFeatureBuffers(bool on) {
+  if (on == features_) return;
+  features_ = on;
+  if (!on) {
+    albedo_ = GlTexture();
+    normal_ = GlTexture();
+    return;
+  }
+  try {
+    if (renderModeSpec(settings_.mode).pathTracer) program();  // compile now: errors surface here
+    albedo_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
+    normal_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
+  } catch (...) {
+    features_ = false;
+    albedo_ = GlTexture();
+    normal_ = GlTexture();
+    throw;
+  }
+  reset();
 }
 
 void Renderer::setCamera(const Camera& camera) {
@@ -333,6 +355,8 @@ void Renderer::allocateImages() {
   comp_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   half_ = GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F);
   coverage_ = transparent_ ? GlTexture::create2D(settings_.width, settings_.height, GL_R32F) : GlTexture();
+  albedo_ = features_ ? GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F) : GlTexture();
+  normal_ = features_ ? GlTexture::create2D(settings_.width, settings_.height, GL_RGBA32F) : GlTexture();
   const int tiles = ((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X) *
                     ((settings_.height + CAUSTICA_WORKGROUP_Y - 1) / CAUSTICA_WORKGROUP_Y);
   tileList_ = GlTexture::create2D(CAUSTICA_TILE_LIST_WIDTH, (tiles + CAUSTICA_TILE_LIST_WIDTH - 1) / CAUSTICA_TILE_LIST_WIDTH,
@@ -346,6 +370,10 @@ void Renderer::reset() {
   comp_.clear();
   half_.clear();
   if (transparent_) coverage_.clear();
+  if (features_) {
+    albedo_.clear();
+    normal_.clear();
+  }
   useAllTiles();
   spp_ = 0;
   sampleBase_ = 0;
@@ -462,6 +490,10 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);
   tileList_.bindImage(CAUSTICA_IMAGE_TILES, GL_READ_ONLY);
   if (hasAlpha()) coverage_.bindImage(CAUSTICA_IMAGE_COVERAGE, GL_READ_WRITE);
+  if (features_) {
+    albedo_.bindImage(CAUSTICA_IMAGE_ALBEDO, GL_READ_WRITE);
+    normal_.bindImage(CAUSTICA_IMAGE_NORMAL, GL_READ_WRITE);
+  }
   // K samples per pixel per dispatch (samplesPerDispatch(): within llvmpipe's loop cap). Sample
   // indices stay global, so the image does not depend on how samples are split into dispatches.
   // The GPU's ray counters are 32-bit: read them into the 64-bit totals before they could wrap
@@ -527,6 +559,10 @@ AccumulationState Renderer::saveAccumulation() const {
   st.comp = comp_.readRgba32f();
   st.half = half_.readRgba32f();
   if (transparent_) st.coverage = coverage_.readR32f();
+  if (features_) {
+    st.albedo = albedo_.readRgba32f();
+    st.normal = normal_.readRgba32f();
+  }
   return st;
 }
 
@@ -539,11 +575,17 @@ void Renderer::restoreAccumulation(const AccumulationState& state) {
     throw Error("the saved accumulation is incomplete");
   if (transparent_ && state.coverage.size() != n / 4)
     throw Error("the saved accumulation has no coverage (alpha): it was not rendered with --background transparent");
+  if (features_ && (state.albedo.size() != n || state.normal.size() != n))
+    throw Error("the saved accumulation has no feature sums: it was rendered without --denoise or --aov");
   reset();
   accum_.uploadRgba32f(state.accum);
   comp_.uploadRgba32f(state.comp);
   half_.uploadRgba32f(state.half);
   if (transparent_) coverage_.uploadR32f(state.coverage);
+  if (features_) {
+    albedo_.uploadRgba32f(state.albedo);
+    normal_.uploadRgba32f(state.normal);
+  }
   spp_ = state.spp;
   sampleBase_ = state.sampleBase;
 }
@@ -571,14 +613,27 @@ Image meanImage(int width, int height, const std::vector<float>& rgba, const std
   return img;
 }
 
-Image Renderer::image() const {
-  const std::vector<float> rgba = accum_.readRgba32f();
+Image Renderer::image() const { return meansOf(accum_.readRgba32f()); }
+
+Image Renderer::meansOf(const std::vector<float>& rgba) const {
   if (!hasAlpha()) return meanImage(settings_.width, settings_.height, rgba, nullptr);
   const std::vector<float> hits = coverage_.readR32f();
   return meanImage(settings_.width, settings_.height, rgba, &hits);
 }
 
-const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {
+const GlTexture& Renderer::denoise() {
+  if (!canDenoise()) return accum_;
+  if (!denoiser_) denoiser_ = std::make_unique<Denoiser>(library_);  // compiles its programs (not timed)
+  const auto t0 = std::chrono::steady_clock::now();
+  const GlTexture& out = denoiser_->run(accum_, albedo_, normal_);
+  denoiseMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+Image Renderer::denoisedImage() { return meansOf(denoise().readRgba32f()); }
+
+const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone, bool denoised) {
+  const GlTexture& source = denoised ? denoise() : accum_;
   if (!tonemapProgram_.id()) {
     ExpandedShader src = library_.expand("tonemap.comp", {});
     tonemapProgram_ = GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); },
@@ -590,7 +645,7 @@ const GlTexture& Renderer::updateDisplay(const ToneMapSettings& tone) {
   glUniform1f(0, std::exp2(tone.exposureStops));
   glUniform1i(1, static_cast<int>(tone.curve));
   glUniform1i(2, hasAlpha() ? 1 : 0);  // composite over a checkerboard (tonemap.comp)
-  accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_ONLY);
+  source.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_ONLY);
   if (hasAlpha()) coverage_.bindImage(CAUSTICA_IMAGE_COVERAGE, GL_READ_ONLY);
   display_.bindImage(CAUSTICA_IMAGE_DISPLAY, GL_WRITE_ONLY);
   glDispatchCompute((settings_.width + CAUSTICA_WORKGROUP_X - 1) / CAUSTICA_WORKGROUP_X,

@@ -29,6 +29,7 @@
 namespace caustica {
 
 class RasterRenderer;
+class Denoiser;
 struct MeshBvhs;
 
 // The PointLights UBO of the raster and Whitted modes: the emitter `groups`, then the scene's punctual
@@ -53,6 +54,11 @@ struct AccumulationState {
   std::vector<float> half;      // rgba32f sums of each pixel's odd-numbered samples (rgb) and their count (a)
   std::vector<float> coverage;  // r32f samples whose camera ray hit the scene, width*height; empty unless
                                 // the background is transparent
+  // The denoiser's feature sums over the same samples (feature_buffers.glsl), width*height*4 each; empty
+  // unless the renderer keeps feature buffers (Renderer::setFeatureBuffers).
+  std::vector<float> albedo;    // rgb: albedo of each sample's first non-specular hit; a: luminance(radiance)^2
+  std::vector<float> normal;    // xyz: its shading normal; w: its distance along the path
+  bool hasFeatures() const { return !albedo.empty(); }
 };
 
 // The per-pixel sums of an AccumulationState that are plain sums of per-sample values (no compensation
@@ -65,8 +71,10 @@ template <class State, class Visit>
 void visitPlainSums(State& s, Visit&& visit) {
   visit("half", s.half);
   visit("coverage", s.coverage);
+  visit("albedo", s.albedo);
+  visit("normal", s.normal);
 }
-static_assert(fieldCount<AccumulationState>() == 8,
+static_assert(fieldCount<AccumulationState>() == 10,
               "AccumulationState has a field that visitPlainSums (or the accum/comp pair) does not cover");
 
 // The mean radiance of each pixel from its running sums (rgb / count; 0 where a pixel has no sample),
@@ -106,6 +114,19 @@ class Renderer {
   int meshBvhBuilds() const { return meshBvhBuilds_; }
 
   void setCamera(const Camera& camera);          // restarts accumulation
+  // Feature buffers (albedo, normal, distance, luminance moment: feature_buffers.glsl) accumulated with
+  // the samples, for the denoiser and --aov; off by default, compiled out of the shader then. Turning
+  // them on restarts accumulation (the samples so far have none); turning them off keeps the samples.
+  // Only the path tracer writes them.
+  void setFeatureBuffers(bool on);
+  bool featureBuffers() const { return features_; }
+  // Whether denoise() filters (feature buffers on, path tracer) rather than copying the raw image.
+  bool canDenoise() const { return features_ && renderModeSpec(settings_.mode).pathTracer; }
+  // Runs the denoiser (gpu/denoiser.h) over the accumulation so far and returns its output: rgba32f in
+  // the accumulation image's convention (rgb = denoised mean x count, a = count). Without canDenoise(),
+  // the accumulation image itself.
+  const GlTexture& denoise();
+  Image denoisedImage();  // denoise(), read back like image()
   // The one place that decides what a settings change needs: new images, another shader variant,
   // new caster parameters; any change restarts accumulation. Throws Error if `settings` is invalid
   // or too large for this GPU, leaving the previous settings in force. Returns what it did, so a
@@ -149,8 +170,10 @@ class Renderer {
   // --background transparent in a mode that tracks coverage (the CAUSTICA_TRANSPARENT row): image()
   // has alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
   bool hasAlpha() const { return variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_TRANSPARENT"); }
-  // Tone-maps the accumulation into the rgba8 display texture (viewer).
-  const GlTexture& updateDisplay(const ToneMapSettings& tone);
+  // Tone-maps the accumulation (with `denoised`, denoise()'s output) into the rgba8 display texture (viewer).
+  const GlTexture& updateDisplay(const ToneMapSettings& tone, bool denoised = false);
+  // Milliseconds the last denoise() took on the GPU (it waits for the GPU to finish); 0 before any.
+  double denoiseMs() const { return denoiseMs_; }
   const RenderStats& stats() const { return stats_; }
   const RenderSettings& settings() const { return settings_; }
   const Camera& camera() const { return camera_; }
@@ -175,6 +198,7 @@ class Renderer {
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
+  Image meansOf(const std::vector<float>& rgba) const;  // meanImage of sums like accum_'s, with coverage alpha
   // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
   void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
@@ -214,6 +238,10 @@ class Renderer {
   GlTexture accum_, comp_, half_, tileList_, display_;
   bool transparent_ = false;  // the scene's background is transparent: coverage_ exists
   GlTexture coverage_;        // r32f camera-ray hits per pixel (CAUSTICA_IMAGE_COVERAGE), if transparent_
+  bool features_ = false;     // feature buffers kept (setFeatureBuffers): albedo_ and normal_ exist
+  GlTexture albedo_, normal_; // rgba32f feature sums (CAUSTICA_IMAGE_ALBEDO, CAUSTICA_IMAGE_NORMAL)
+  std::unique_ptr<Denoiser> denoiser_;  // made at the first denoise()
+  double denoiseMs_ = 0.0;
   std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_
   int liveTileSize_ = CAUSTICA_WORKGROUP_X;  // side of those tiles in pixels
   bool tileListActive_ = false;

@@ -94,12 +94,18 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
       {"spectral", "CAUSTICA_SPECTRAL", K::Integrator, "dispersion by hero wavelengths (else one RGB channel per path)",
        "--dispersion spectral and a dispersive glass", isDispersive, nullptr,
        [](const RenderSettings& s) { return s.dispersion == DispersionMode::Spectral; }, nullptr, A::Keep},
+      // ---- what the path tracer records beside the image (FeatureKind::Output) ----
+      {"feature-buffers", "CAUSTICA_AOV", K::Output,
+       "the denoiser's feature buffers: albedo, normal and distance of the first non-specular hit, the luminance "
+       "moment (glsl/lib/feature_buffers.glsl)",
+       "the renderer keeps feature buffers: render --denoise or --aov, the viewer's denoiser (Renderer::setFeatureBuffers)",
+       nullptr, nullptr, nullptr, nullptr, A::Keep},
   };
   return table;
 }
 
 const char* featureKindName(FeatureKind k) {
-  return k == FeatureKind::Scene ? "scene" : k == FeatureKind::Image ? "image" : "integrator";
+  return k == FeatureKind::Scene ? "scene" : k == FeatureKind::Image ? "image" : k == FeatureKind::Integrator ? "integrator" : "output";
 }
 
 std::size_t shaderFeatureIndex(const std::string& define) {
@@ -139,7 +145,7 @@ FeatureSet detectFeatures(const Scene& scene, const GpuScene& gpu) {
   const auto& table = shaderFeatureTable();
   for (std::size_t i = 0; i < table.size(); ++i) {
     const ShaderFeature& row = table[i];
-    bool on = !row.material && !row.scene;
+    bool on = !row.material && !row.scene && row.kind != FeatureKind::Output;  // output rows: the Renderer's
     for (std::size_t m = 0; m < scene.materials.size() && row.material && !on; ++m)
       on = used[m] && row.material(scene.materials[m]);
     if (!on && row.scene) on = row.scene(view);
@@ -150,11 +156,11 @@ FeatureSet detectFeatures(const Scene& scene, const GpuScene& gpu) {
 
 namespace {
 bool modeCompiles(const RenderModeSpec& mode, FeatureKind kind) {
-  return mode.entryShader && (kind != FeatureKind::Integrator || mode.pathTracer);
+  return mode.entryShader && ((kind != FeatureKind::Integrator && kind != FeatureKind::Output) || mode.pathTracer);
 }
 }  // namespace
 
-FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settings) {
+FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settings, bool featureBuffers) {
   const RenderModeSpec& mode = renderModeSpec(settings.mode);
   const bool all = settings.allFeatures && mode.pathTracer;
   FeatureSet f;
@@ -162,7 +168,7 @@ FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settin
   for (std::size_t i = 0; i < table.size(); ++i) {
     const ShaderFeature& row = table[i];
     if (!modeCompiles(mode, row.kind)) continue;
-    bool on = scene.test(i) && (!row.settings || row.settings(settings));
+    bool on = row.kind == FeatureKind::Output ? featureBuffers : scene.test(i) && (!row.settings || row.settings(settings));
     if (all && row.allFeatures != AllFeatures::Keep) on = row.allFeatures == AllFeatures::Force;
     if (on && row.needs) on = f.has(row.needs);
     f.set(i, on);

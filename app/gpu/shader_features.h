@@ -21,8 +21,10 @@ enum class FeatureKind {
   Image,       // what the image holds beside colour (alpha coverage): the scene and the render mode
   Integrator,  // the path tracer's estimators, from the settings: only in modes whose RenderModeSpec
                // has pathTracer
+  Output,      // what the path tracer records beside the image (the denoiser's feature buffers): on when
+               // the Renderer keeps them (Renderer::setFeatureBuffers), whatever the scene; path tracer only
 };
-const char* featureKindName(FeatureKind k);  // "scene" | "image" | "integrator"
+const char* featureKindName(FeatureKind k);  // "scene" | "image" | "integrator" | "output"
 
 // What --all-features (the unspecialised path tracer, RenderSettings::allFeatures) does with a row.
 enum class AllFeatures {
@@ -80,9 +82,10 @@ class FeatureSet {
 // is not asked). `gpu` is `scene` packed (packScene, packInstancedScene).
 FeatureSet detectFeatures(const Scene& scene, const GpuScene& gpu);
 // The rows one compute variant compiles: those of `scene` whose settings test holds and whose kind
-// the mode compiles (none without an entry shader; integrator rows only in the path tracer), with
-// --all-features applied (path tracer only) and each row's `needs` checked.
-FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settings);
+// the mode compiles (none without an entry shader; integrator and output rows only in the path
+// tracer), the output rows when `featureBuffers`, with --all-features applied (path tracer only) and
+// each row's `needs` checked.
+FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settings, bool featureBuffers = false);
 // Every row the mode's entry shader can read (what the shader tests compile combinations of).
 FeatureSet modeFeatureRows(RenderMode mode);
 

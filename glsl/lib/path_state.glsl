@@ -22,6 +22,9 @@ struct PathState {
   uint depth;          // bounces so far (path segments traced, alpha pass-throughs not counted)
   uint passThroughs;   // alpha pass-throughs: not bounces, so they do not consume the depth cap
   uvec4 rng;
+#ifdef CAUSTICA_AOV
+  SampleFeatures feat;  // the denoiser's features of this sample (feature_buffers.glsl)
+#endif
 };
 
 // Sample `sampleIndex` (global) of the pixel: its random stream, keyed by (pixel, sample index, seed),
@@ -44,6 +47,9 @@ PathState startPath(uvec2 pixel, uint sampleIndex) {
   s.firstDiffuse = true;
   s.depth = 0u;
   s.passThroughs = 0u;
+#ifdef CAUSTICA_AOV
+  s.feat = noFeatures();
+#endif
 #ifdef CAUSTICA_TRANSPARENT
   gCameraRayMissed = false;
 #endif

@@ -56,6 +56,21 @@ using uint = std::uint32_t;
 #define CAUSTICA_IMAGE_HALF 3         // image unit: rgba32f sum (rgb) and count (a) of each pixel's odd-numbered samples (error estimate)
 #define CAUSTICA_IMAGE_TILES 4        // image unit: r32ui list of live tiles (adaptive sampling), x | y << 16 in tiles
 #define CAUSTICA_IMAGE_COVERAGE 5     // image unit: r32f samples whose camera ray hit the scene (--background transparent)
+#define CAUSTICA_IMAGE_ALBEDO 6       // image unit: rgba32f feature sums (CAUSTICA_AOV): albedo (rgb), luminance^2 (a)
+#define CAUSTICA_IMAGE_NORMAL 7       // image unit: rgba32f feature sums (CAUSTICA_AOV): shading normal (xyz), distance (w)
+// The denoiser's image units (denoise.comp, its own program; docs/denoising.md).
+#define CAUSTICA_DENOISE_IMAGE_ACCUM 0   // rgba32f accumulation sums (read)
+#define CAUSTICA_DENOISE_IMAGE_ALBEDO 1  // rgba32f feature sums: albedo, luminance^2 (read by the prepare stage)
+#define CAUSTICA_DENOISE_IMAGE_FILTERED 1  // rgba32f the filter passes' last output (read by the residual passes)
+#define CAUSTICA_DENOISE_IMAGE_NORMAL 2  // rgba32f feature sums: normal, distance (read by the prepare stage)
+#define CAUSTICA_DENOISE_IMAGE_MOMENTS 2 // rgba32f feature sums: albedo, luminance^2 (read by the last residual pass)
+#define CAUSTICA_DENOISE_IMAGE_PING 3    // rgba32f demodulated illumination (rgb) and variance of the mean (a), or
+                                         // the residual (rgb), read by a pass
+#define CAUSTICA_DENOISE_IMAGE_PONG 4    // the same, written by a pass (and by prepare)
+#define CAUSTICA_DENOISE_IMAGE_GUIDE 5   // rgba32f unit mean normal (xyz; 0: none) and mean distance (w; -1: no samples)
+#define CAUSTICA_DENOISE_IMAGE_CENTRE 6  // rgba32f albedo (rgb, floored) and distance gradient (a)
+#define CAUSTICA_DENOISE_IMAGE_OUTPUT 7  // rgba32f denoised sums (rgb = mean x count, a = count), or the residual
+                                         // the last filter pass writes
 #define CAUSTICA_TILE_LIST_WIDTH 1024 // texels per row of the live-tile list image
 #define CAUSTICA_WORKGROUP_X 8        // compute work-group size in pixels
 #define CAUSTICA_WORKGROUP_Y 8

@@ -12,6 +12,7 @@
 #include "../lib/punctual.glsl"  // without CAUSTICA_PUNCTUAL: spotFalloff only (no UBO)
 #include "../lib/oct_normal.glsl"
 #include "../lib/texture_wrap.glsl"
+#include "../lib/denoise.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -57,6 +58,7 @@ const uint kSpotFalloff = 26u;
 const uint kOctDecode = 27u;
 const uint kWrapCoord = 28u;
 const uint kLayers = 29u;
+const uint kDenoiseTapWeight = 30u;
 
 // The Bsdf of records for kBsdfEvalPdf and kBsdfSample: a[0].w = alpha, a[1].w = eta,
 // a[2] = (color, lobe), a[3].xy = (f0 grey, f90).
@@ -184,6 +186,14 @@ void main() {
     vec3 f;  // bsdfEvalPdf: bsdfEval and bsdfPdf in one body (the path tracer's vertexEvalPdf and bsdfSample call it)
     float pdf = bsdfEvalPdf(b, a[0].xyz, a[1].xyz, f);
     o[0] = bits(f, pdf);
+  } else if (function == kDenoiseTapWeight) {  // a[0] = (np, zp), a[1] = (nq, zq), a[2] = (depthScale, lumDiff, lumScale, n),
+                                                // a[3] = (m2, l, albedoP, albedoQ)
+    o[0].x = floatBitsToUint(denoiseTapWeight(a[0].xyz, a[1].xyz, a[0].w, a[1].w, a[2].x, a[2].y, a[2].z));
+    o[0].y = floatBitsToUint(denoiseNormalWeight(a[0].xyz, a[1].xyz));
+    o[0].z = floatBitsToUint(denoiseMeanVariance(a[2].w, a[3].x, a[3].y));
+    o[0].w = floatBitsToUint(denoiseLuminanceScale(2.0, a[3].x, a[3].y, a[3].z, a[3].w));
+    vec4 g = denoiseGuide(a[0].xyz, a[3].z, a[0].w);
+    o[1] = floatBitsToUint(vec4(denoiseGuideNormal(g), denoiseGuideAlbedo(g)));
   } else if (function == kBsdfSample) {  // a[0].xyz = wo, a[1].xyz = u: wi, pdf, weight, transmitted, ok
     BsdfSample bs;
     bool ok = bsdfSample(recordBsdf(a), a[0].xyz, a[1].xyz, bs);

@@ -100,7 +100,7 @@ TEST_CASE("checkpoint: the coverage image of a transparent render round-trips; o
   spit(path, v3);
   CHECK_THROWS_WITH_AS(readCheckpoint(path),
                        doctest::Contains("coverage.ckpt: not a usable caustica checkpoint: version 3 (this caustica "
-                                         "reads versions 4 to 5, whose settings name every option that changes the image; "
+                                         "reads versions 4 to 6, whose settings name every option that changes the image; "
                                          "render again to write one)"),
                        Error);
 }
@@ -121,11 +121,11 @@ TEST_CASE("checkpoint: truncated, corrupted and foreign files are refused with t
   std::string v1 = good;
   v1.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 1");
   spit(path, v1);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 4 to 5"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 1 (this caustica reads versions 4 to 6"), Error);
   std::string v6 = good;
-  v6.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 6");
+  v6.replace(0, std::string("CAUSTICA-CKPT 5").size(), "CAUSTICA-CKPT 7");
   spit(path, v6);
-  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 6 (this caustica reads versions 4 to 5)"), Error);
+  CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("version 7 (this caustica reads versions 4 to 6)"), Error);
   spit(path, "P6\n1 1\n255\nabc");
   CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("no CAUSTICA-CKPT header"), Error);
   CHECK_THROWS_AS(readCheckpoint(tempPath("missing.ckpt")), Error);
@@ -173,4 +173,39 @@ TEST_CASE("checkpoint: a write interrupted before its rename leaves the previous
   // A write that cannot happen (its folder is gone) throws and touches nothing else.
   CHECK_THROWS_WITH_AS(writeCheckpoint(tempPath("nope") + "/x/y.ckpt", first), doctest::Contains("y.ckpt.tmp"), Error);
   fs::remove_all(fs::path(path).parent_path());
+}
+
+TEST_CASE("checkpoint: the denoiser's feature sums (version 6) round-trip, with and without coverage and a shard line; without them it stays version 5") {
+  for (bool coverage : {false, true}) {
+    INFO("coverage ", coverage);
+    const std::string path = tempPath("features.ckpt");
+    Checkpoint a = sample(3, 2, 2.5f);
+    if (coverage) a.state.coverage.assign(6, 3.0f);
+    if (coverage) a.shard = SampleShare{2, 3, 4, 8, 12};  // a shard's partial with feature sums
+    for (int i = 0; i < 3 * 2 * 4; ++i) {
+      a.state.albedo.push_back(0.1f * float(i));
+      a.state.normal.push_back(-0.3f * float(i));
+    }
+    writeCheckpoint(path, a);
+    CHECK(slurp(path).rfind(std::string(kCheckpointMagic) + " 6\n", 0) == 0);
+    const Checkpoint b = readCheckpoint(path);
+    CHECK(b.shard == a.shard);
+    CHECK(b.state.albedo == a.state.albedo);
+    CHECK(b.state.normal == a.state.normal);
+    CHECK(b.state.coverage == a.state.coverage);
+    CHECK(b.state.accum == a.state.accum);
+    // A flipped bit in the feature sums fails the checksum; a missing image is a truncated file.
+    std::string bytes = slurp(path);
+    bytes[bytes.size() - 5] ^= 0x10;
+    spit(path, bytes);
+    CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("checksum"), Error);
+    spit(path, slurp(path).substr(0, bytes.size() - 4 * 24));
+    CHECK_THROWS_WITH_AS(readCheckpoint(path), doctest::Contains("truncated"), Error);
+    fs::remove(path);
+  }
+  const std::string path = tempPath("plain.ckpt");
+  writeCheckpoint(path, sample(3, 2, 1.0f));
+  CHECK(slurp(path).rfind(std::string(kCheckpointMagic) + " 5\n", 0) == 0);  // readable by older versions
+  CHECK_FALSE(readCheckpoint(path).state.hasFeatures());
+  fs::remove(path);
 }

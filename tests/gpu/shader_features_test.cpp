@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "accel/bvh.h"
+#include "gpu/denoiser.h"
 #include "gpu/scene_buffers.h"
 #include "gpu/shader_features.h"
 #include "gpu/shader_library.h"
@@ -119,7 +120,8 @@ TEST_CASE("shader features: every row is documented in docs/shader-features.md, 
 TEST_CASE("shader features: every row is read by a shader that compiles it, and every feature #ifdef of the shaders is a row") {
   ShaderLibrary library;
   // Names the data sets, not the table: the storage layout's (SceneBufferLayout::defines, here for a
-  // split, textured layout) and the instanced traversal's (GpuScene::instanceDefines).
+  // split, textured layout), the instanced traversal's (GpuScene::instanceDefines) and the denoiser's
+  // stages (denoiseStageDefines).
   SceneBufferLayout layout;
   layout.texcoords = true;
   for (SplitArray* a : {&layout.nodes, &layout.triGeom, &layout.triShade}) {
@@ -131,6 +133,7 @@ TEST_CASE("shader features: every row is read by a shader that compiles it, and 
   std::set<std::string> known;
   for (const std::vector<std::string>& list : {layout.defines(), instanced.instanceDefines()})
     for (const std::string& d : list) known.insert(d.substr(0, d.find('=')));
+  for (const char* stage : denoiseStageDefines()) known.insert(stage);  // denoise.comp's stage selectors
   // And names the sources #define themselves (gpu_layout.h's constants, whitted.comp's occluder filter).
   static const std::regex defined(R"(#\s*define\s+(CAUSTICA_[A-Z0-9_]+))");
   for (const EmbeddedShader& s : embeddedShaders()) {
@@ -306,4 +309,15 @@ TEST_CASE("shader features: --all-features compiles every scene row in, drops th
   all.dispersion = DispersionMode::Spectral;  // spectral needs a dispersive glass in the scene, forced or not
   CHECK_FALSE(variantFeatures(envOnly, all).has("CAUSTICA_SPECTRAL"));
   CHECK(variantFeatures(rows({"CAUSTICA_SPECTRAL"}), all).has("CAUSTICA_SPECTRAL"));
+}
+
+TEST_CASE("shader features: the output rows (the denoiser's feature buffers) follow the renderer, in the path tracer only") {
+  RenderSettings path, whitted;
+  whitted.mode = RenderMode::Whitted;
+  const FeatureSet none = rows({});
+  CHECK_FALSE(variantFeatures(none, path).has("CAUSTICA_AOV"));
+  CHECK(variantFeatures(none, path, true).has("CAUSTICA_AOV"));
+  CHECK_FALSE(variantFeatures(none, whitted, true).has("CAUSTICA_AOV"));  // whitted.comp records no features
+  Scene s;
+  CHECK_FALSE(detect(s).has("CAUSTICA_AOV"));  // never the scene's
 }

@@ -12,6 +12,7 @@
 #include <glslang/Public/ShaderLang.h>
 
 #include "util/error.h"
+#include "gpu/denoiser.h"
 #include "gpu/render_mode.h"
 #include "gpu/shader_features.h"
 #include "gpu/shader_library.h"
@@ -136,6 +137,11 @@ TEST_CASE("the other entry shaders compile") {
                             "tests/environment_test.comp"}) {
     std::string log = validate(lib.expand(entry, {}));
     INFO(entry);
+    CHECK_MESSAGE(log.empty(), log);
+  }
+  for (const char* stage : denoiseStageDefines()) {
+    std::string log = validate(lib.expand("denoise.comp", {stage}));
+    INFO("denoise.comp: " << stage);
     CHECK_MESSAGE(log.empty(), log);
   }
 }

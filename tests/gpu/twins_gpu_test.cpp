@@ -25,6 +25,7 @@
 #include "shading/sampling.h"
 #include "scene/punctual_lights.h"
 #include "gl_test_util.h"
+#include "image/denoise.h"
 
 using namespace caustica;
 using caustica::test::sameBits;
@@ -37,7 +38,7 @@ enum class Fn : GLuint {
   PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
   ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
   DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError, Ggx, GgxSampleVisibleNormal, BsdfEvalPdf, BsdfSample, SpotFalloff, OctDecode,
-  WrapCoord, Layers
+  WrapCoord, Layers, DenoiseTapWeight
 };
 
 constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
@@ -993,4 +994,49 @@ TEST_CASE("GLSL layers equal their C++ twins: coatFresnel, sheenD, sheenL, sheen
   dV.check();
   dE.check();
   dDir.check();
+}
+
+TEST_CASE("GLSL denoiser arithmetic equals its C++ twin: denoiseTapWeight, denoiseNormalWeight, denoiseMeanVariance, "
+          "denoiseLuminanceScale, denoiseGuide") {
+  GlslTwins gpu;
+  Random r(31);
+  std::vector<In> in;
+  // No surface on either side or both, equal and opposite normals, zero differences, samples that all
+  // agree (m2 = n l^2), then random taps: normals a few degrees to 90 degrees apart, distances and
+  // luminance differences around their scales, albedos equal or near.
+  const glm::vec3 up(0, 0, 1), none(0.0f);
+  for (glm::vec3 nq : {up, none, -up, glm::normalize(glm::vec3(0.1f, 0, 1))})
+    for (glm::vec3 np : {up, none}) in.push_back(floats({np, 2.0f}, {nq, 2.0f}, {0.01f, 0.0f, 1.0f, 16.0f}, {16.0f * 0.25f, 0.5f, 0.7f, 0.7f}));
+  while (in.size() < 4096) {
+    const glm::vec3 np = r.unit();
+    const glm::vec3 nq = glm::normalize(np + r.unit() * r.uniform(0.0f, 1.0f));
+    const float zp = r.uniform(0.1f, 10.0f), scale = r.uniform(1e-3f, 1.0f), lumScale = r.uniform(1e-3f, 2.0f);
+    const float n = std::floor(r.uniform(2.0f, 1000.0f)), l = r.uniform(0.0f, 5.0f), m2 = n * l * l * r.uniform(1.0f, 3.0f);
+    const float ap = r.uniform(0.0f, 1.0f), aq = r.uniform(0.0f, 1.0f) < 0.5f ? ap : ap + r.uniform(-0.05f, 0.05f);
+    in.push_back(floats({np, zp}, {nq, zp + r.uniform(-2.0f, 2.0f) * scale}, {scale, r.uniform(-4.0f, 4.0f) * lumScale, lumScale, n},
+                        {m2, l, ap, aq}));
+  }
+  std::vector<Out> out = gpu.run(Fn::DenoiseTapWeight, in);
+  // dot^128 by seven squarings (exact in both, products rounded alike) times one exp of a sum of two
+  // quotients: llvmpipe's exp differs from std::exp by a few ULP (measured 4.9e-7 relative). The
+  // luminance scale: an exp and a sqrt (measured 1.1e-7). The variance (relative to the mean square), the
+  // normal weight and the guide's normal and albedo: measured 0.
+  MaxDiff weight("denoiseTapWeight", 8 * kEps), normal("denoiseNormalWeight", 4 * kEps), variance("denoiseMeanVariance", 4 * kEps),
+      scale("denoiseLuminanceScale", 8 * kEps), guideNormal("denoiseGuideNormal", 16 * kEps), guideAlbedo("denoiseGuideAlbedo", 2 * kEps);
+  for (size_t i = 0; i < in.size(); ++i) {
+    const glm::vec4 a = arg(in[i], 0), b = arg(in[i], 1), c = arg(in[i], 2), d = arg(in[i], 3);
+    const float np[3] = {a.x, a.y, a.z}, nq[3] = {b.x, b.y, b.z};
+    const float cw = denoiseTapWeight(np, nq, a.w, b.w, c.x, c.y, c.z), cn = denoiseNormalWeight(np, nq);
+    const float cv = denoiseMeanVariance(c.w, d.x, d.y), cs = denoiseLuminanceScale(2.0f, d.x, d.y, d.z, d.w);
+    const glm::vec4 g = denoiseGuide(glm::vec3(a), d.z, a.w);
+    const float gw = out[i].f(0, 0), gn = out[i].f(0, 1), gv = out[i].f(0, 2), gs = out[i].f(0, 3);
+    auto where = [&](float x, float y) { return [&, x, y] { return str(in[i]) + ": " + str(x) + " vs " + str(y); }; };
+    weight.add(relDiff(gw, cw, 1e-20), where(gw, cw));
+    normal.add(absDiff(gn, cn), where(gn, cn));
+    variance.add(absDiff(gv, cv) / std::max(double(d.x) / c.w, 1e-30), where(gv, cv));  // relative to the mean square
+    scale.add(relDiff(gs, cs), where(gs, cs));
+    guideNormal.add(absDiff(out[i].v(1), denoiseGuideNormal(g)), where(out[i].f(1, 2), denoiseGuideNormal(g).z));
+    guideAlbedo.add(absDiff(out[i].f(1, 3), denoiseGuideAlbedo(g)), where(out[i].f(1, 3), denoiseGuideAlbedo(g)));
+  }
+  for (const MaxDiff* m : {&weight, &normal, &variance, &scale, &guideNormal, &guideAlbedo}) m->check();
 }

@@ -71,3 +71,46 @@ TEST_CASE("PNG files are written") {
   CHECK(fs::file_size(p) > 50);
   fs::remove(p);
 }
+
+TEST_CASE("EXR layers: named channel layers beside the image round-trip exactly (render --aov)") {
+  Image img = testImage();
+  img.alpha.assign(size_t(img.width) * img.height, 0.5f);
+  ImageLayer albedo{"albedo", {"R", "G", "B"}, std::vector<float>(img.rgb.size())};
+  ImageLayer depth{"depth", {"Z"}, std::vector<float>(size_t(img.width) * img.height)};
+  for (size_t i = 0; i < albedo.data.size(); ++i) albedo.data[i] = 0.01f * float(i);
+  for (size_t i = 0; i < depth.data.size(); ++i) depth.data[i] = 3.0f + float(i);
+  const fs::path p = fs::temp_directory_path() / "caustica_io_layers.exr";
+  writeExrLayers(p.string(), img, {albedo, depth});
+  int w = 0, h = 0;
+  const std::vector<ImageLayer> back = readExrLayers(p.string(), w, h);
+  CHECK(w == img.width);
+  CHECK(h == img.height);
+  REQUIRE(back.size() == 3);
+  for (const ImageLayer& l : back) {
+    INFO("layer '", l.name, "'");
+    if (l.name.empty()) {  // the image itself: A, B, G, R as the file sorts them
+      REQUIRE(l.channels.size() == 4);
+      for (size_t k = 0; k < 4; ++k)
+        for (size_t i = 0; i < img.alpha.size(); ++i) {
+          const std::string& c = l.channels[k];
+          const float expected = c == "A" ? img.alpha[i] : img.rgb[i * 3 + (c == "R" ? 0 : c == "G" ? 1 : 2)];
+          CHECK(l.data[i * 4 + k] == expected);
+        }
+    } else if (l.name == "albedo") {
+      CHECK(l.channels == std::vector<std::string>{"B", "G", "R"});
+      for (size_t i = 0; i < img.alpha.size(); ++i)
+        for (int c = 0; c < 3; ++c) CHECK(l.data[i * 3 + size_t(2 - c)] == albedo.data[i * 3 + size_t(c)]);
+    } else {
+      CHECK(l.name == "depth");
+      CHECK(l.data == depth.data);
+    }
+  }
+  // The image itself reads back as before: the layers do not disturb readImage.
+  Image rgb = readImage(p.string());
+  for (size_t i = 0; i < img.rgb.size(); ++i) CHECK(rgb.rgb[i] == img.rgb[i]);
+  CHECK_THROWS_AS(writeExrLayers(p.string(), img, {albedo, albedo}), Error);  // a repeated layer
+  ImageLayer wrong = depth;
+  wrong.data.pop_back();
+  CHECK_THROWS_AS(writeExrLayers(p.string(), img, {wrong}), Error);
+  fs::remove(p);
+}

@@ -242,10 +242,20 @@ std::map<std::string, BenchSceneInfo> readBenchScenes(const std::string& path) {
   return parseBenchScenes(readFileText(path), path);
 }
 
+double imageMean(const Image& image, const PixelRect& r) {
+  if (r.empty() || r.x0 < 0 || r.y0 < 0 || r.x1 > image.width || r.y1 > image.height)
+    throw Error("internal: region outside the image");
+  double s = 0.0;
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x)
+      for (int c = 0; c < 3; ++c) s += image.at(x, y, c);
+  return s / (3.0 * r.width() * r.height());
+}
+
 std::string benchCsvHeader() {
   return "scene,integrator,dispersion,width,height,checkpoint,seconds,spp,samples_per_s,rays_per_s,primary_rays,"
          "secondary_rays,shadow_rays,non_finite,relmse,relmse_caustic,reference_noise,reference_noise_caustic,"
-         "gl_renderer,cpu_seconds";
+         "gl_renderer,cpu_seconds,mean_ratio,mean_ratio_caustic,filter_seconds";
 }
 
 std::string benchCsvRow(const BenchRow& r) {
@@ -255,7 +265,8 @@ std::string benchCsvRow(const BenchRow& r) {
     << formatNumber(r.samplesPerSecond) << ',' << formatNumber(r.raysPerSecond) << ',' << r.primaryRays << ','
     << r.secondaryRays << ',' << r.shadowRays << ',' << r.nonFinite << ',' << formatNumber(r.relMse) << ','
     << formatNumber(r.relMseCaustic) << ',' << formatNumber(r.referenceNoise) << ','
-    << formatNumber(r.referenceNoiseCaustic) << ',' << csvField(r.glRenderer) << ',' << formatNumber(r.cpuSeconds);
+    << formatNumber(r.referenceNoiseCaustic) << ',' << csvField(r.glRenderer) << ',' << formatNumber(r.cpuSeconds) << ','
+    << formatNumber(r.meanRatio) << ',' << formatNumber(r.meanRatioCaustic) << ',' << formatNumber(r.filterSeconds);
   return o.str();
 }
 

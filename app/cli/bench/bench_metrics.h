@@ -4,6 +4,7 @@
 // bench/scenes.json, the CSV rows and number formatting for the report.
 #pragma once
 #include <cstddef>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -40,6 +41,9 @@ PixelRect fullImage(int width, int height);
 // the sizes differ or the region leaves the image.
 double relMse(const Image& image, const Image& reference);
 double relMse(const Image& image, const Image& reference, const PixelRect& region);
+
+// The mean of `image` over `region`, every channel (linear radiance).
+double imageMean(const Image& image, const PixelRect& region);
 
 // The error of the reference (halfA + halfB) / 2 itself, in relMSE units, when halfA and halfB are
 // independent renders with the same number of samples: E[(A - B)^2] = 2 var(half) = 4 var(mean), so
@@ -121,6 +125,9 @@ struct BenchRow {
   double relMseCaustic = 0.0;     // caustic region; NaN when the scene has none
   double referenceNoise = 0.0;    // the reference's own relMSE estimate, whole image; NaN if unknown
   double referenceNoiseCaustic = 0.0;
+  // The image's mean over the reference's (1: the same), whole image and caustic region (NaN: none).
+  double meanRatio = std::nan(""), meanRatioCaustic = std::nan("");
+  double filterSeconds = 0.0;     // denoised runs (bench --denoise): the denoiser's time, included in `seconds`
 };
 std::string benchCsvHeader();
 std::string benchCsvRow(const BenchRow& row);  // no trailing newline; NaN written as "nan"

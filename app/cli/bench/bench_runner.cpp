@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "cli/bench/bench_metrics.h"
+#include "cli/bench/denoise_ladder.h"
 #include "cli/bench/reference_cache.h"
 #include "cli/bench/report.h"
 #include "gpu/adaptive_sampler.h"
@@ -79,6 +80,7 @@ class BenchRunner {
     std::string scenesJson = findScenesJson(opts);
     if (!scenesJson.empty()) sceneInfo_ = readBenchScenes(scenesJson);
     else note(quiet_, "warning: bench/scenes.json not found: no caustic regions (use --scenes-json FILE)");
+    denoise_ = opts.has("--denoise");
     std::error_code ec;
     fs::create_directories(outDir_, ec);
     if (ec) throw Error(outDir_ + ": cannot create the output folder (" + ec.message() + ")");
@@ -103,7 +105,17 @@ class BenchRunner {
     ReferenceCache cache(cacheDir_, opts_.has("--refresh-reference"), setup_.glRenderer, quiet_);
     auto start = Clock::now();
     for (const auto& path : paths) benchScene(library, cache, path);
-    if (!opts_.has("--adaptive-bound")) writeSummary(outDir_, summaryMarkdown(setup_, secondsSince(start), all_), quiet_);
+    if (opts_.has("--adaptive-bound")) return 0;
+    std::string summary = summaryMarkdown(setup_, secondsSince(start), all_);
+    if (denoise_) {
+      summary += denoiseSummaryMarkdown(ladders_);
+      const std::string csv = outDir_ + "/denoise.csv";
+      std::ofstream f(csv, std::ios::binary);
+      f << denoiseLadderCsv(ladders_);
+      if (!f) throw Error(csv + ": cannot write");
+      note(quiet_, "wrote " + csv);
+    }
+    writeSummary(outDir_, summary, quiet_);
     return 0;
   }
 
@@ -165,6 +177,22 @@ class BenchRunner {
         if (std::find(adaptiveIntegrators_.begin(), adaptiveIntegrators_.end(), integrator) !=
             adaptiveIntegrators_.end())
           results.push_back(measure(renderer, name, ref, caustic, true));
+      }
+      if (denoise_) {  // mis with the denoiser: over time (its filter on the clock), then at fixed spp
+        RenderSettings run = settings;
+        run.dispersion = mode;
+        run.integrator = Integrator::Mis;
+        renderer.apply(run);
+        results.push_back(measure(renderer, name, ref, caustic, false, true));
+        Renderer plain(library, ls.scene, ls.camera, run);
+        DenoiseLadder ladder = runDenoiseLadder(renderer, plain, name, ref, caustic, quiet_);
+        const std::string stem = name + (modes.size() > 1 ? "-" + std::string(dispersionModeName(mode)) : "");
+        writePlot(outDir_, "denoise-" + stem, denoiseLadderPlot(setup_, ladder, stem), opts_.get("--gnuplot", "gnuplot"), quiet_);
+        const Canvas figure = composeDenoiseFigure(ladder, ls.settings.tone);
+        writePng(outDir_ + "/bench-denoise-" + stem + "-pictures.png", figure.width, figure.height, figure.rgb);
+        ladder.pictures.clear();  // the summary needs the figures only
+        ladder.reference = Image{};
+        ladders_.push_back(std::move(ladder));
       }
     }
     if (opts_.has("--adaptive-bound")) return;
@@ -258,12 +286,16 @@ class BenchRunner {
   // run samples the live tiles of AdaptiveSampler (docs/adaptive-sampling.md), checked at its fixed
   // schedule; those checks (read-back, estimate, tile list) are part of adaptive sampling's cost and
   // are on the clock. Its target is 0: it never stops early, so its error curve spans the same time.
+  // A `denoised` run keeps the feature buffers and measures the denoised image at each checkpoint, the
+  // denoiser's time on its clock (each checkpoint's image costs the render so far and one filter).
   RunResult measure(Renderer& renderer, const std::string& name, const Reference& ref,
-                    const std::optional<PixelRect>& caustic, bool adaptive) {
+                    const std::optional<PixelRect>& caustic, bool adaptive, bool denoised = false) {
     const RenderSettings& s = renderer.settings();
+    renderer.setFeatureBuffers(denoised);
     RunResult out;
     out.scene = name;
-    out.integrator = estimatorName(s, !renderer.gpuScene().casters.empty()) + (adaptive ? " adaptive" : "");
+    out.integrator = estimatorName(s, !renderer.gpuScene().casters.empty()) + (adaptive ? " adaptive" : "") +
+                     (denoised ? " denoised" : "");
     out.dispersion = dispersionModeName(s.dispersion);
     out.noise = ref.noise;
     out.noiseCaustic = ref.noiseCaustic;
@@ -297,7 +329,13 @@ class BenchRunner {
       while (next < schedule.size() && schedule[next] <= elapsed) ++next;
 
       const RenderStats& st = renderer.stats();
-      Image img = renderer.image();
+      double filterSeconds = 0.0;
+      if (denoised) {
+        const auto f0 = Clock::now();
+        renderer.denoise();  // waits for the GPU
+        filterSeconds = secondsSince(f0);
+      }
+      Image img = denoised ? renderer.denoisedImage() : renderer.image();  // (the read-back is not timed)
       BenchRow row;
       row.scene = name;
       row.integrator = out.integrator;
@@ -306,8 +344,9 @@ class BenchRunner {
       row.width = s.width;
       row.height = s.height;
       row.checkpoint = static_cast<int>(out.rows.size());
-      row.seconds = elapsed;
-      row.cpuSeconds = cpu;
+      row.seconds = elapsed + filterSeconds;
+      row.cpuSeconds = cpu + filterSeconds;
+      row.filterSeconds = filterSeconds;
       row.spp = renderer.samplesPerPixel();
       // Adaptive runs sample some pixels only: count the paths traced (GPU counter) instead.
       row.samplesPerSecond = adaptive ? double(st.primaryRays) / elapsed : row.spp * pixels / elapsed;
@@ -320,6 +359,8 @@ class BenchRunner {
       row.relMseCaustic = caustic ? relMse(img, ref.image, *caustic) : std::nan("");
       row.referenceNoise = ref.noise;
       row.referenceNoiseCaustic = ref.noiseCaustic;
+      row.meanRatio = imageMean(img, fullImage(s.width, s.height)) / imageMean(ref.image, fullImage(s.width, s.height));
+      row.meanRatioCaustic = caustic ? imageMean(img, *caustic) / imageMean(ref.image, *caustic) : std::nan("");
       out.rows.push_back(row);
       if (!quiet_) {
         std::fprintf(stderr, "\rcaustica: %s %s/%s: %6.2f s %6d spp  relMSE %.3g%s   ", name.c_str(),
@@ -330,6 +371,7 @@ class BenchRunner {
     }
     if (!quiet_) std::fprintf(stderr, "\n");
     renderer.useAllTiles();
+    renderer.setFeatureBuffers(false);
     if (out.rows.back().nonFinite > 0)
       note(quiet_, "warning: " + name + " " + out.integrator + ": " + std::to_string(out.rows.back().nonFinite) +
                        " non-finite samples were rejected");
@@ -345,6 +387,8 @@ class BenchRunner {
   std::vector<DispersionMode> dispersions_;
   std::map<std::string, BenchSceneInfo> sceneInfo_;
   bool boundHeader_ = false;    // --adaptive-bound: the table's header is printed
+  bool denoise_ = false;        // --denoise: denoised runs and the fixed-spp ladder (denoise_ladder.h)
+  std::vector<DenoiseLadder> ladders_;
   std::vector<RunResult> all_;  // every run of every scene so far, for the summary
 };
 

@@ -33,8 +33,9 @@ const char* const kViewerControls =
     "  + -  (0)             exposure +/- 0.5 stop (reset)\n"
     "  T                    tone curve: aces / clamp\n"
     "  space                pause / resume sampling (changes apply on resume)\n"
-    "  P                    screenshot: caustica-SCENE-Nspp.png and .exr, at the end of the pass in flight\n"
+    "  P                    screenshot as shown: caustica-SCENE-Nspp[-denoised].png and .exr, at the end of the pass in flight\n"
     "  G                    stop refining at the target relMSE (--target-error, default 0.01) on / off\n"
+    "  N                    denoiser on (default) / off: the denoised or the raw image (path mode; docs/denoising.md)\n"
     "  H                    print these controls\n"
     "  Esc                  quit\n";
 
@@ -82,6 +83,11 @@ void applyKeys(GlfwWindow& window, CameraController& controller, ViewControls& c
         break;
       case GLFW_KEY_P: c.screenshotPending = true; break;
       case GLFW_KEY_G: c.stopAtTarget = !c.stopAtTarget; break;
+      case GLFW_KEY_N:
+        c.denoise = !c.denoise;
+        c.redraw = true;
+        std::cout << "caustica: denoiser " << (c.denoise ? "on" : "off (raw image)") << "\n" << std::flush;
+        break;
       case GLFW_KEY_H: std::cout << kViewerControls << std::flush; break;
       default: break;
     }

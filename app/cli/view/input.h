@@ -1,5 +1,6 @@
 // input.h — the viewer's keys and mouse: camera motion for the CameraController, and the toggles
-// (render mode, integrator, casters, dispersion, depth, exposure, tone curve, pause, fly, screenshot) they set.
+// (render mode, integrator, casters, dispersion, depth, exposure, tone curve, pause, fly, screenshot,
+// denoiser) they set.
 #pragma once
 #include "gpu/render_settings.h"
 #include "image/tonemap.h"
@@ -23,6 +24,7 @@ struct ViewControls {
   bool stopAtTarget = false;       // G: stop refining once the estimated relMSE reaches targetError
   double targetError = 0.01;       // relMSE (--target-error; G toggles stopping there)
   bool instancedScene = false;     // M skips the modes that draw flat scenes only (RenderModeSpec::instancedScenes)
+  bool denoise = true;             // N: show the denoised image (path mode; the raw one otherwise)
 };
 
 class ViewerInput {

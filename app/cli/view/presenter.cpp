@@ -4,8 +4,8 @@
 
 namespace caustica {
 
-void Presenter::keepPreview(Renderer& renderer, const ToneMapSettings& tone) {
-  const GlTexture& d = renderer.updateDisplay(tone);
+void Presenter::keepPreview(Renderer& renderer, const ToneMapSettings& tone, bool denoised) {
+  const GlTexture& d = renderer.updateDisplay(tone, denoised);
   if (previewCopy_.width() != d.width() || previewCopy_.height() != d.height()) {
     previewCopy_ = GlTexture::create2D(d.width(), d.height(), GL_RGBA8);
     previewCopyFb_ = GlFramebuffer::forTexture(previewCopy_);
@@ -15,9 +15,9 @@ void Presenter::keepPreview(Renderer& renderer, const ToneMapSettings& tone) {
 }
 
 void Presenter::draw(Renderer& renderer, const ToneMapSettings& tone, int windowWidth, int windowHeight,
-                     std::optional<int> finishedRows) {
+                     std::optional<int> finishedRows, bool denoised) {
   const int ww = windowWidth, wh = windowHeight;
-  const GlTexture& d = renderer.updateDisplay(tone);
+  const GlTexture& d = renderer.updateDisplay(tone, denoised);
   if (displayFbStale_ || d.id() != displayFbTexture_) {
     displayFb_ = GlFramebuffer::forTexture(d);
     displayFbTexture_ = d.id();

@@ -45,6 +45,7 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
   controls_.wanted = settings;
   controls_.tone = scene_.settings.tone;
   controls_.stopAtTarget = config_.targetError > 0.0;
+  controls_.denoise = config_.denoise;
   if (config_.targetError > 0.0) controls_.targetError = config_.targetError;
   input_ = ViewerInput(controls_, config_.spinRadians);
 
@@ -62,6 +63,7 @@ Viewer::Viewer(const Options& opts, const ViewConfig& config)
 
   library_ = std::make_unique<ShaderLibrary>(shaderLibraryFrom(opts));
   renderer_ = std::make_unique<Renderer>(*library_, scene_.scene, scene_.camera, settings);
+  renderer_->setFeatureBuffers(controls_.denoise);  // the denoiser's inputs (kept once on: N only changes the display)
   warmUp();
   present();  // compiles the tone-mapping shader and whatever the blit needs, before anything is timed
   presented_ = 0;
@@ -85,15 +87,19 @@ void Viewer::syncRenderer() {
   next.width = renderer_->settings().width;
   next.height = renderer_->settings().height;
   SettingsChange change = renderer_->apply(next);
-  if (change.shader) warmUp();
   bool restarted = change.restart;
+  if (controls_.denoise && !renderer_->featureBuffers()) {  // N turned the denoiser on: it needs the feature sums
+    renderer_->setFeatureBuffers(true);
+    change.shader = restarted = true;
+  }
+  if (change.shader) warmUp();
   if (controller_->revision() != appliedRevision_) {
     renderer_->setCamera(controller_->camera());
     appliedRevision_ = controller_->revision();
     restarted = true;
   }
   ResolutionChoice res = pacer_.chooseResolution(fullW_, fullH_, now(), restarted);
-  if (res.leftPreview) presenter_.keepPreview(*renderer_, controls_.tone);
+  if (res.leftPreview) presenter_.keepPreview(*renderer_, controls_.tone, showDenoised());
   if (resizeRenderer(res.width, res.height)) restarted = true;
   if (restarted) {
     estimate_ = std::numeric_limits<double>::infinity();
@@ -172,7 +178,13 @@ void Viewer::present() {
   double t = now();
   std::optional<int> finishedRows;  // first full pass in flight: its rows over the preview
   if (showPreviewCopy_ && !pacer_.previewing() && renderer_->samplesPerPixel() == 0) finishedRows = pacer_.passRow();
-  presenter_.draw(*renderer_, controls_.tone, ww, wh, finishedRows);
+  const bool denoised = showDenoised();
+  presenter_.draw(*renderer_, controls_.tone, ww, wh, finishedRows, denoised);
+  if (denoised) {  // the denoiser's share of the frame (Renderer::denoiseMs: it waits for the GPU)
+    // The first run is left out: llvmpipe compiles the programs at their first dispatch (about a second).
+    if (denoised_ > 0) denoiseMs_ += (denoised_ == 1 ? 1.0 : 0.1) * (renderer_->denoiseMs() - denoiseMs_);
+    ++denoised_;
+  }
   pacer_.recordDisplay((now() - t) * 1000.0, presented_);
   window_->swapBuffers();
   controls_.redraw = newSamples_ = false;
@@ -219,15 +231,19 @@ void Viewer::updateTitle(bool force) {
   if (controls_.stopAtTarget) title += format(" | target %.3g", controls_.targetError);
   if (pacer_.previewing()) title += " | preview 1/" + std::to_string(pacer_.previewScale());
   if (controls_.fly) title += " | fly";
+  title += showDenoised() ? format(" | denoised (N) %.1f ms", denoiseMs_) : std::string(" | raw (N)");
   if (controls_.paused) title += " | paused";
   if (done()) title += " | done";
   window_->setTitle(title);
 }
 
+Image Viewer::shownImage() const { return showDenoised() ? renderer_->denoisedImage() : renderer_->image(); }
+
 void Viewer::writeScreenshotPair() {
-  std::string base = "caustica-" + sceneName_ + "-" + std::to_string(renderer_->samplesPerPixel()) + "spp";
+  std::string base = "caustica-" + sceneName_ + "-" + std::to_string(renderer_->samplesPerPixel()) + "spp" +
+                     (showDenoised() ? "-denoised" : "");
   try {
-    Image img = renderer_->image();
+    Image img = shownImage();
     writeImage(base + ".png", img, controls_.tone);
     writeImage(base + ".exr", img);
     note(config_.quiet, "wrote " + base + ".png and " + base + ".exr");
@@ -279,17 +295,18 @@ int Viewer::run() {
   if (config_.frameLimit > 0 && !closed) finishPass();
   if (config_.frameLimit > 0) {
     updateTitle(true);
-    std::printf("%d frames in %.2f s (%.1f ms/frame), %d shown (%.1f fps), %.3g samples/s; %dx%d, %d spp%s\n", frames_,
+    std::printf("%d frames in %.2f s (%.1f ms/frame), %d shown (%.1f fps), %.3g samples/s; %dx%d, %d spp%s%s\n", frames_,
                 loopSeconds, 1000.0 * loopSeconds / std::max(frames_, 1), loopPresented,
                 loopPresented / std::max(loopSeconds, 1e-9), static_cast<double>(loopSamples) / std::max(loopSeconds, 1e-9),
                 renderer_->settings().width, renderer_->settings().height, renderer_->samplesPerPixel(),
-                std::isfinite(estimate_) ? format(", relMSE~%.3g", estimate_).c_str() : "");
+                std::isfinite(estimate_) ? format(", relMSE~%.3g", estimate_).c_str() : "",
+                denoised_ > 1 ? format("; denoised, %.1f ms a shown frame", denoiseMs_).c_str() : denoised_ ? "; denoised" : "; raw");
     if (controls_.stopAtTarget && done()) std::printf("target relMSE %.3g reached\n", controls_.targetError);
   }
   if (!config_.screenshotPath.empty()) {
-    writeImage(config_.screenshotPath, renderer_->image(), controls_.tone);
-    std::printf("screenshot %s: %dx%d, %d spp\n", config_.screenshotPath.c_str(), renderer_->settings().width,
-                renderer_->settings().height, renderer_->samplesPerPixel());
+    writeImage(config_.screenshotPath, shownImage(), controls_.tone);
+    std::printf("screenshot %s: %dx%d, %d spp%s\n", config_.screenshotPath.c_str(), renderer_->settings().width,
+                renderer_->settings().height, renderer_->samplesPerPixel(), showDenoised() ? ", denoised" : "");
   }
   std::fflush(stdout);
   return 0;

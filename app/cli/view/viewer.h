@@ -31,6 +31,7 @@ struct ViewConfig {
   bool preview = true;         // lower resolution while the camera moves, when full passes do not fit
   double spinRadians = 0.0;    // orbit per frame
   bool fixedSize = false;      // --size given: render resolution fixed, the window scales the image
+  bool denoise = true;         // show the denoised image (--no-denoise: the raw one; key N toggles)
 };
 
 #ifdef CAUSTICA_HAVE_GLFW
@@ -56,6 +57,8 @@ class Viewer {
     return pacer_.done(renderer_->samplesPerPixel()) || (controls_.stopAtTarget && estimate_ <= controls_.targetError);
   }
   void estimateAfterPass();  // the error estimate at scheduled sample counts (docs/adaptive-sampling.md)
+  bool showDenoised() const { return controls_.denoise && renderer_->canDenoise(); }
+  Image shownImage() const;  // the linear image the window shows: denoised or raw
 
   ViewConfig config_;
   Clock::time_point start_ = Clock::now();
@@ -88,6 +91,8 @@ class Viewer {
   double lastTitle_ = -1.0, rateT0_ = 0.0;  // seconds
   std::uint64_t rateS0_ = 0;
   double samplesPerSecond_ = 0.0;
+  double denoiseMs_ = 0.0;     // moving average of the denoiser's time per shown frame, milliseconds
+  int denoised_ = 0;           // frames shown denoised
 };
 
 #endif  // CAUSTICA_HAVE_GLFW

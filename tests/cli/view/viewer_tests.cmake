@@ -15,8 +15,9 @@ if(CAUSTICA_VIEWER)
     # RESOURCE_LOCK: concurrent `xvfb-run -a` calls can race for the same server number.
     # The window's screenshot after some frames equals `render` with the same seed and spp: once with
     # the default budget, once with a tiny budget (passes split in row bands, a preview first).
-    # The Whitted mode too (its jittered samples are seeded alike; docs/render-modes.md).
-    foreach(case "default;64;;" "banded;96x72;--budget-ms 2;" "whitted;64;;whitted")
+    # The Whitted mode too (its jittered samples are seeded alike; docs/render-modes.md). The path mode
+    # shows the denoised image (docs/denoising.md), compared with render --denoise; --no-denoise the raw one.
+    foreach(case "default;64;;" "banded;96x72;--budget-ms 2;" "whitted;64;;whitted" "raw;64;--no-denoise;")
       list(GET case 0 name)
       list(GET case 1 size)
       list(GET case 2 viewArgs)
