@@ -101,6 +101,19 @@ layout(location = 1) uniform int last;  // the last pass: 1 writes the output; 2
 
 // The kernel of a pass by |offset|: 1/4, 1/2, 1/4.
 const float kKernel[2] = float[](1.0 / 2.0, 1.0 / 4.0);
+
+// Tap t (0..8, row by row; 4 is the centre) of an à-trous pass around p, `step` pixels apart: its pixel
+// q, kernel weight and guide gq; false for the centre and for taps outside the image or without samples
+// (the C++ twin's forEachTap).
+bool denoiseTap(ivec2 p, int t, int step, ivec2 size, out ivec2 q, out float kernel, out vec4 gq) {
+  ivec2 o = ivec2(t % 3 - 1, t / 3 - 1);
+  q = p + step * o;
+  kernel = kKernel[abs(o.x)] * kKernel[abs(o.y)];
+  gq = vec4(0.0, 0.0, 0.0, -1.0);
+  if (t == 4 || !insideImage(q, size)) return false;
+  gq = imageLoad(guideImage, q);
+  return gq.w >= 0.0;
+}
 #endif
 
 #ifdef CAUSTICA_DENOISE_PASS
@@ -127,21 +140,19 @@ void main() {
   float sumW = kKernel[0] * kKernel[0];
   vec3 sumI = sumW * cp.rgb;
   float sumV = sumW * sumW * cp.a;
-  for (int j = -1; j <= 1; ++j)
-    for (int k = -1; k <= 1; ++k) {
-      if (j == 0 && k == 0) continue;
-      ivec2 q = p + step * ivec2(k, j);
-      if (!insideImage(q, size)) continue;
-      vec4 gq = imageLoad(guideImage, q);
-      if (gq.w < 0.0) continue;
-      vec4 cq = imageLoad(pingImage, q);
-      float lumDiff = luminance(ctr.rgb * (cq.rgb - cp.rgb));
-      float ls = denoiseLuminanceScale(sigmaLuminance, cp.a, cq.a, ap, denoiseGuideAlbedo(gq));
-      float wq = kKernel[abs(j)] * kKernel[abs(k)] * denoiseTapWeight(np, denoiseGuideNormal(gq), gp.w, gq.w, ds, lumDiff, ls);
-      sumW += wq;
-      sumI += wq * cq.rgb;
-      sumV += wq * wq * cq.a;
-    }
+  for (int t = 0; t < 9; ++t) {
+    ivec2 q;
+    float kernel;
+    vec4 gq;
+    if (!denoiseTap(p, t, step, size, q, kernel, gq)) continue;
+    vec4 cq = imageLoad(pingImage, q);
+    float lumDiff = luminance(ctr.rgb * (cq.rgb - cp.rgb));
+    float ls = denoiseLuminanceScale(sigmaLuminance, cp.a, cq.a, ap, denoiseGuideAlbedo(gq));
+    float wq = kernel * denoiseTapWeight(np, denoiseGuideNormal(gq), gp.w, gq.w, ds, lumDiff, ls);
+    sumW += wq;
+    sumI += wq * cq.rgb;
+    sumV += wq * wq * cq.a;
+  }
   vec3 illum = sumI / sumW;
   imageStore(pongImage, p, vec4(illum, sumV / (sumW * sumW)));
   if (last == 0) return;
@@ -177,19 +188,16 @@ void main() {
   float ds = denoiseDepthScale(sigmaDepth, ctr.a, step, gp.w);
   float sumW = kKernel[0] * kKernel[0];
   vec3 sumR = sumW * rp.rgb;
-  for (int j = -1; j <= 1; ++j)
-    for (int k = -1; k <= 1; ++k) {
-      if (j == 0 && k == 0) continue;
-      ivec2 q = p + step * ivec2(k, j);
-      if (!insideImage(q, size)) continue;
-      vec4 gq = imageLoad(guideImage, q);
-      if (gq.w < 0.0) continue;
-      vec4 rq = imageLoad(pingImage, q);
-      float wq = kKernel[abs(j)] * kKernel[abs(k)] *
-                 denoiseTapWeight(np, denoiseGuideNormal(gq), gp.w, gq.w, ds, rp.a - rq.a, sigmaResidual * (rp.a + rq.a) + kDenoiseTiny);
-      sumW += wq;
-      sumR += wq * rq.rgb;
-    }
+  for (int t = 0; t < 9; ++t) {
+    ivec2 q;
+    float kernel;
+    vec4 gq;
+    if (!denoiseTap(p, t, step, size, q, kernel, gq)) continue;
+    vec4 rq = imageLoad(pingImage, q);
+    float wq = kernel * denoiseTapWeight(np, denoiseGuideNormal(gq), gp.w, gq.w, ds, rp.a - rq.a, sigmaResidual * (rp.a + rq.a) + kDenoiseTiny);
+    sumW += wq;
+    sumR += wq * rq.rgb;
+  }
   vec3 spread = sumR / sumW;
   imageStore(pongImage, p, vec4(spread, rp.a));
   if (last != 0) {

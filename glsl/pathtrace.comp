@@ -65,7 +65,7 @@ bool pathBounce(inout PathState s) {
 #endif
   Surface sf;
   if (!surfaceAt(hit, s.dir, true, sf)) return false;  // surface.glsl
-  vec4 base = materialBaseColor(sf.m, sf.uv);
+  vec4 base = materialBaseColor(sf.m, sf.uv, sf.color);
 #ifdef CAUSTICA_OPACITY
   if (passThrough(s, sf, base.a)) return true;  // path_scatter.glsl: an alpha cut-out (absent: no emission either)
 #endif

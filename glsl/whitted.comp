@@ -91,7 +91,9 @@ vec3 directLight(vec3 p, vec3 pError, vec3 ng, vec3 ns, vec3 wv, vec3 base, floa
 
 vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
   gSp = 0u;
-  pushRay(frame.camPos.xyz, eyeRayDirection(pixel, rand2(rng)), vec3(1.0), vec3(0.0), 0u);
+  vec3 eyeOrg, eyeDir;
+  eyeRay(pixel, rand2(rng), eyeOrg, eyeDir);
+  pushRay(eyeOrg, eyeDir, vec3(1.0), vec3(0.0), 0u);
   uint maxDepth = min(frame.options.x, kWhittedMaxDepth);
   vec3 radiance = vec3(0.0);
   for (uint rays = 0u; rays < kWhittedMaxRays && gSp > 0u; ++rays) {
@@ -111,7 +113,7 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
     Surface sf;
     if (!surfaceAt(hit, r.dir, false, sf)) continue;  // surface.glsl (Phong shading takes no normal map)
 
-    vec4 base = materialBaseColor(sf.m, sf.uv);
+    vec4 base = materialBaseColor(sf.m, sf.uv, sf.color);
     float alpha = 1.0;
 #ifdef CAUSTICA_OPACITY
     alpha = base.a;

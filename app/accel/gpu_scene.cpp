@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <glm/gtc/packing.hpp>
+
 #include "accel/intersect.h"
 #include "accel/tlas.h"
 #include "scene/caustic_casters.h"
@@ -29,6 +31,14 @@ std::vector<bool> usedMaterials(const Scene& scene) {
   return used;
 }
 
+std::vector<std::string> TriShadeLayout::defines() const {
+  std::vector<std::string> d;
+  if (texcoords) d.push_back("CAUSTICA_TRISHADE_TEXCOORDS");
+  if (colors) d.push_back("CAUSTICA_TRISHADE_COLORS");
+  if (tangents) d.push_back("CAUSTICA_TRISHADE_TANGENTS");
+  return d;
+}
+
 namespace {
 std::uint32_t floatBits(float f) {
   std::uint32_t u;
@@ -36,25 +46,37 @@ std::uint32_t floatBits(float f) {
   return u;
 }
 
-// TriShade words per triangle: with full-float texcoords where a material some triangle uses reads a
-// texture (the CAUSTICA_TEXTURES row of gpu/shader_features.cpp asks the same of the materials).
-std::uint32_t triShadeStride(const Scene& scene) {
+// The TriShade blocks the scene needs: full-float texcoords where a material some triangle uses reads
+// a texture (the CAUSTICA_TEXTURES row of gpu/shader_features.cpp asks the same of the materials),
+// vertex colours where the scene has them, tangents where it has them and textures (normal maps).
+void setTriShadeLayout(const Scene& scene, GpuScene& g) {
   const std::vector<bool> used = usedMaterials(scene);
   for (std::size_t m = 0; m < scene.materials.size(); ++m)
-    if (used[m] && scene.materials[m].readsTextures()) return gpu::kTriShadeWordsTextured;
-  return gpu::kTriShadeWords;
+    g.triShadeLayout.texcoords = g.triShadeLayout.texcoords || (used[m] && scene.materials[m].readsTextures());
+  g.triShadeLayout.colors = !scene.colors.empty();
+  g.triShadeLayout.tangents = g.triShadeLayout.texcoords && !scene.tangents.empty();
+  g.triShadeStride = g.triShadeLayout.stride();
 }
 
-// Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, stride): its octahedral normals, then
-// full-float texcoords only where textures read them (half floats would move a texel on large textures).
-void writeTriShade(const Scene& scene, std::size_t tri, std::uint32_t stride, std::uint32_t* w) {
+// Scene triangle `tri`'s shading words (gpu_layout.h) at w[0, layout.stride()): its octahedral normals,
+// then full-float texcoords only where textures read them (half floats would move a texel on large
+// textures), vertex colours as half floats, tangents octahedral with the sign in bit 0.
+void writeTriShade(const Scene& scene, std::size_t tri, const TriShadeLayout& layout, std::uint32_t* w) {
   for (int k = 0; k < 3; ++k) w[k] = scene.triangles[tri].normalWord[k];  // stored octahedral already (scene.h)
-  if (stride == gpu::kTriShadeWordsTextured)
+  if (layout.texcoords)
     for (int k = 0; k < 3; ++k) {
       const glm::vec2 uv = triangleUv(scene, tri, k);
       w[3 + 2 * k] = floatBits(uv.x);
       w[4 + 2 * k] = floatBits(uv.y);
     }
+  if (layout.colors)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec4 c = triangleColor(scene, tri, k);
+      w[layout.colorOffset() + 2 * std::uint32_t(k)] = glm::packHalf2x16(glm::vec2(c.r, c.g));
+      w[layout.colorOffset() + 2 * std::uint32_t(k) + 1] = glm::packHalf2x16(glm::vec2(c.b, c.a));
+    }
+  if (layout.tangents)
+    for (int k = 0; k < 3; ++k) w[layout.tangentOffset() + std::uint32_t(k)] = tangentWord(triangleTangent(scene, tri, k));
 }
 
 // The environment's texels, CDFs and UBO. An environment lights every point from everywhere, so
@@ -92,7 +114,7 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
     geom[j].v0 = glm::vec4(q0, glm::uintBitsToFloat(t.material));
     geom[j].v1 = glm::vec4(q1, glm::uintBitsToFloat(leaf == gpu::kInvalidIndex ? 0u : leaf + 1u));
     geom[j].v2 = glm::vec4(q2, 0.0f);
-    writeTriShade(scene, bvh.order[i], g.triShadeStride, shade.data() + j * g.triShadeStride);
+    writeTriShade(scene, bvh.order[i], g.triShadeLayout, shade.data() + j * g.triShadeStride);
   }
 }
 
@@ -140,6 +162,13 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
     const auto texIndex = [](int t) { return t >= 0 ? static_cast<std::uint32_t>(t) : gpu::kInvalidIndex; };
     if (m.alphaFromTexture) gm.tex.z |= gpu::kMatAlphaTexture;
     if (m.alphaFromTexture && m.alphaCutoff >= 0.0f) gm.tex.z |= gpu::kMatAlphaMask;
+    if (g.triShadeLayout.colors && m.alphaFromVertices) {  // COLOR_0's alpha joins factor and texture
+      gm.tex.z |= gpu::kMatVertexAlpha;
+      if (m.alphaCutoff >= 0.0f) {  // MASK: thresholded per hit, from the factor's own alpha
+        gm.tex.z |= gpu::kMatAlphaMask;
+        gm.baseColor.a = m.maskAlpha;
+      }
+    }
     gm.specular = glm::vec4(m.specularF0, m.specularF90);
     gm.tex2 = glm::uvec4(texIndex(m.metallicRoughnessTexture), texIndex(m.normalTexture),
                          floatBits(m.normalScale), floatBits(m.alphaCutoff));
@@ -192,7 +221,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triangleCount = bvh.order.size();
-  g.triShadeStride = triShadeStride(scene);
+  setTriShadeLayout(scene, g);
   packMaterialsAndTextures(scene, g);
 
   // Emitters: every triangle whose material emits, weighted by luminance * area * sides.
@@ -220,7 +249,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
 GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   if (bvh.triSource.size() != bvh.tris.size()) throw Error("internal: packInstancedScene without triSource");
   GpuScene g;
-  g.triShadeStride = triShadeStride(scene);
+  setTriShadeLayout(scene, g);
   // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
   // the light-leaf table).
   std::vector<std::uint32_t> emissiveIndex(scene.triangles.size(), gpu::kInvalidIndex);
@@ -260,7 +289,7 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
     const std::uint32_t i = bvh.triSource[x];
     storedIndex[i] = static_cast<std::uint32_t>(x);
     g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
-    writeTriShade(scene, i, g.triShadeStride, g.triShade.data() + x * g.triShadeStride);
+    writeTriShade(scene, i, g.triShadeLayout, g.triShade.data() + x * g.triShadeStride);
   }
 
   // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
@@ -333,9 +362,20 @@ glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k) {
 }
 
 glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k) {
-  if (g.triShadeStride != gpu::kTriShadeWordsTextured) return glm::vec2(0.0f);
+  if (!g.triShadeLayout.texcoords) return glm::vec2(0.0f);
   const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + 3 + 2 * k;
   return glm::vec2(glm::uintBitsToFloat(w[0]), glm::uintBitsToFloat(w[1]));
+}
+
+glm::vec4 shadeColor(const GpuScene& g, std::size_t tri, int k) {
+  if (!g.triShadeLayout.colors) return glm::vec4(1.0f);
+  const std::uint32_t* w = g.triShade.data() + tri * g.triShadeStride + g.triShadeLayout.colorOffset() + 2 * k;
+  return glm::vec4(glm::unpackHalf2x16(w[0]), glm::unpackHalf2x16(w[1]));
+}
+
+glm::vec4 shadeTangent(const GpuScene& g, std::size_t tri, int k) {
+  if (!g.triShadeLayout.tangents) return glm::vec4(0.0f);
+  return tangentFromWord(g.triShade[tri * g.triShadeStride + g.triShadeLayout.tangentOffset() + std::size_t(k)]);
 }
 
 std::vector<std::string> GpuScene::instanceDefines() const {

@@ -20,12 +20,25 @@ std::vector<bool> usedMaterials(const Scene& scene);
 // metallicRoughness texture), or a diffuse part with a specular layer (specularF90 > 0).
 bool hasRoughLobe(const Material& m);
 
+// Which optional blocks the TriShade words of each triangle hold (gpu_layout.h), and where.
+struct TriShadeLayout {
+  bool texcoords = false;  // the material UV set (a used material reads a texture)
+  bool colors = false;     // COLOR_0 as half floats (Scene::colors not empty)
+  bool tangents = false;   // TANGENT, octahedral (Scene::tangents not empty, and texcoords)
+  std::uint32_t colorOffset() const { return gpu::kTriShadeWords + (texcoords ? gpu::kTriShadeTexcoordWords : 0u); }
+  std::uint32_t tangentOffset() const { return colorOffset() + (colors ? gpu::kTriShadeColorWords : 0u); }
+  std::uint32_t stride() const { return tangentOffset() + (tangents ? gpu::kTriShadeTangentWords : 0u); }
+  // CAUSTICA_TRISHADE_TEXCOORDS, _COLORS, _TANGENTS for the blocks present (tri_shade.glsl).
+  std::vector<std::string> defines() const;
+};
+
 struct GpuScene {
   std::vector<gpu::BvhNode> nodes;
   std::size_t triangleCount = 0;        // triangles (TriGeom records), also when triGeom is not filled
   std::vector<gpu::TriGeom> triGeom;    // BVH leaf order
   std::vector<std::uint32_t> triShade;  // BVH leaf order, triShadeStride words per triangle (gpu_layout.h)
-  std::uint32_t triShadeStride = gpu::kTriShadeWords;  // kTriShadeWordsTextured where a used material reads textures
+  TriShadeLayout triShadeLayout;        // the blocks those words hold
+  std::uint32_t triShadeStride = gpu::kTriShadeWords;  // triShadeLayout.stride()
   std::vector<gpu::Material> materials;
   std::size_t emitterCount = 0;         // emissive triangles of positive power: the light tree's leaves
   LightTree lightTree;                  // light tree over the same triangles: what the shaders sample (binding 4)
@@ -67,6 +80,8 @@ void packTriangleRange(const Scene& scene, const Bvh& bvh, const GpuScene& g, st
 // (BVH leaf order) as the shaders decode them from GpuScene::triShade (tri_shade.glsl).
 glm::vec3 shadeNormal(const GpuScene& g, std::size_t tri, int k);
 glm::vec2 shadeUv(const GpuScene& g, std::size_t tri, int k);  // (0, 0) in scenes without textures
+glm::vec4 shadeColor(const GpuScene& g, std::size_t tri, int k);  // (1, 1, 1, 1) without vertex colours
+glm::vec4 shadeTangent(const GpuScene& g, std::size_t tri, int k);  // (0, 0, 0, 0) without tangents
 
 // What the scene occupies on the GPU, in bytes, by storage block (gpu/renderer.cpp uploads these).
 struct GpuSceneBytes {

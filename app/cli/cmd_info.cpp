@@ -109,9 +109,12 @@ int cmdInfo(const std::vector<std::string>& args) {
     std::printf("origin:     (%.17g, %.17g, %.17g) (rebased in double; bounds and camera are relative to it)\n",
                 s.origin.x, s.origin.y, s.origin.z);
   const Camera& c = ls.camera;
-  std::printf("camera:     %s at %s looking %s, yfov %.1f deg%s (%zu in file)\n",
+  char view[64];
+  if (c.orthographic()) std::snprintf(view, sizeof view, "orthographic, %g high", 2.0 * double(c.orthoHeight));
+  else std::snprintf(view, sizeof view, "yfov %.1f deg", double(c.yfov) * 57.29578);
+  std::printf("camera:     %s at %s looking %s, %s%s (%zu in file)\n",
               s.cameras.empty() ? "automatic" : ("'" + c.name + "'").c_str(), vec(c.position).c_str(),
-              vec(c.forward).c_str(), c.yfov * 57.29578f, c.aspect > 0 ? (", aspect " + std::to_string(c.aspect)).c_str() : "",
+              vec(c.forward).c_str(), view, c.aspect > 0 ? (", aspect " + std::to_string(c.aspect)).c_str() : "",
               s.cameras.size());
   GpuSceneBytes bytes = gpuSceneBytes(g);
   if (instanced) {

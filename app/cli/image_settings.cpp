@@ -124,6 +124,7 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& c)
   for (float v : {c.position.x, c.position.y, c.position.z, c.forward.x, c.forward.y, c.forward.z, c.up.x, c.up.y,
                   c.up.z, c.yfov, c.aspect})
     t += ' ' + settingText(v);
+  if (c.orthographic()) t += " orthographic " + settingText(c.orthoHeight);  // (pinhole identities as before)
   return t + '\n';
 }
 

@@ -28,7 +28,8 @@ bool isMirrorMaterial(const gpu::Material& m) { return m.params.x >= 0.5f && !is
 
 // Uniform locations (raster.vert / raster.frag / shadow.*).
 constexpr GLint kUViewProj = 0, kUClipPlane = 1, kUEye = 2, kUBaseColor = 3, kUEmission = 4, kUParams = 5,
-                kUHasTexture = 6, kUPlanarMirror = 7, kUShadowTexels = 8, kULightPosFar = 1;
+                kUHasTexture = 6, kUPlanarMirror = 7, kUShadowTexels = 8, kUVertexAlpha = 9, kUVertexColors = 10,
+                kULightPosFar = 1;
 
 }  // namespace
 
@@ -99,7 +100,7 @@ RasterMesh buildRasterMesh(const GpuScene& scene) {
     const glm::vec2 uv[3] = {shadeUv(scene, i, 0), shadeUv(scene, i, 1), shadeUv(scene, i, 2)};
     for (int k = 0; k < 3; ++k) {
       glm::vec3 ns = glm::length(nn[k]) > 0.5f ? glm::normalize(nn[k]) : geomNormal[i];
-      mesh.vertices.push_back({p[k], ns, uv[k], geomNormal[i]});
+      mesh.vertices.push_back({p[k], ns, uv[k], geomNormal[i], shadeColor(scene, i, k)});
     }
   };
   auto batchesOf = [&](int which, std::vector<RasterMesh::Batch>& out) {
@@ -133,7 +134,7 @@ RasterMesh buildRasterMesh(const GpuScene& scene) {
 }
 
 RasterRenderer::RasterRenderer(const ShaderLibrary& library, const GpuScene& scene, const gpu::PointLights& lights)
-    : materials_(scene.materials) {
+    : materials_(scene.materials), vertexColors_(scene.triShadeLayout.colors) {
   mesh_ = buildRasterMesh(scene);
   auto compile = [&](const char* vs, const char* fs) {
     ExpandedShader v = library.expand(vs, {});
@@ -148,7 +149,7 @@ RasterRenderer::RasterRenderer(const ShaderLibrary& library, const GpuScene& sce
   using V = RasterMesh::Vertex;
   vao_ = GlVertexArray::create(vertexBuffer_, sizeof(V),
                                {{0, 3, offsetof(V, position)}, {1, 3, offsetof(V, normal)}, {2, 2, offsetof(V, uv)},
-                                {3, 3, offsetof(V, geomNormal)}});
+                                {3, 3, offsetof(V, geomNormal)}, {4, 4, offsetof(V, color)}});
   for (const gpu::TexInfo& t : scene.texInfo) {
     auto wrap = [](bool repeat, bool mirror) { return mirror ? GL_MIRRORED_REPEAT : repeat ? GL_REPEAT : GL_CLAMP_TO_EDGE; };
     textures_.push_back(GlTexture::createSrgb8(static_cast<int>(t.width), static_cast<int>(t.height),
@@ -207,6 +208,7 @@ void RasterRenderer::setMaterial(std::uint32_t material, bool planarMirror) cons
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, textured ? textures_[m.tex.x].id() : 0);
   glUniform1i(kUPlanarMirror, planarMirror ? 1 : 0);
+  glUniform1i(kUVertexAlpha, (m.tex.z & gpu::kMatVertexAlpha) != 0u ? 1 : 0);
 }
 
 void RasterRenderer::drawBatches(const std::vector<RasterMesh::Batch>& batches) const {
@@ -243,7 +245,10 @@ namespace {
 // The clip-space transform of `camera` for a w x h image (row 0 at the top, as the accumulation image),
 // its far plane beyond everything in `mesh` (twice that with mirrors: the reflected scene lies up to
 // twice as far).
-glm::mat4 cameraViewProjection(const Camera& camera, int w, int h, const RasterMesh& mesh, float& far) {
+// The camera's view-projection and `eye`, the point the shading's view vectors start from: the camera's
+// position, or for an orthographic camera a point far behind its image plane (drawn from there with
+// the same view volume, so that the view vectors are parallel too).
+glm::mat4 cameraViewProjection(const Camera& camera, int w, int h, const RasterMesh& mesh, float& far, glm::vec3& eye) {
   // The compute camera's frame: right = forward x up, image row 0 at the top.
   glm::vec3 fwd = glm::normalize(camera.forward);
   glm::vec3 right = glm::normalize(glm::cross(fwd, camera.up));
@@ -257,10 +262,14 @@ glm::mat4 cameraViewProjection(const Camera& camera, int w, int h, const RasterM
       far = std::max(far, glm::length(corner - camera.position) * 1.01f);
     }
   if (!mesh.mirrors.empty()) far *= 2.0f;
-  glm::mat4 proj = glm::perspective(camera.yfov, static_cast<float>(w) / static_cast<float>(h), far * 1e-4f, far);
+  const float aspect = static_cast<float>(w) / static_cast<float>(h), h2 = camera.orthoHeight;
+  const float back = camera.orthographic() ? 1000.0f * far : 0.0f;
+  eye = camera.position - fwd * back;
+  glm::mat4 proj = camera.orthographic() ? glm::ortho(-h2 * aspect, h2 * aspect, -h2, h2, back, back + far)
+                                         : glm::perspective(camera.yfov, aspect, far * 1e-4f, far);
   // GL's window row 0 is the bottom; the accumulation image's row 0 is the top: flip y in clip space.
   proj = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, -1.0f, 1.0f)) * proj;
-  return proj * glm::lookAt(camera.position, camera.position + fwd, up);
+  return proj * glm::lookAt(eye, eye + fwd, up);
 }
 
 // Clears the bound framebuffer (black, alpha 1; depth 1; stencil 0) and sets the state of the opaque pass.
@@ -291,7 +300,8 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
   if (depthStencil_.width() != w || depthStencil_.height() != h) depthStencil_ = GlTexture::createDepthStencil(w, h);
   framebuffer_ = GlFramebuffer::forTargets(target, depthStencil_);  // cheap; the target may be new
   float far = 1.0f;
-  const glm::mat4 viewProj = cameraViewProjection(camera, w, h, mesh_, far);
+  glm::vec3 eye;
+  const glm::mat4 viewProj = cameraViewProjection(camera, w, h, mesh_, far, eye);
 
   GLint viewport[4];
   glGetIntegerv(GL_VIEWPORT, viewport);
@@ -302,15 +312,16 @@ void RasterRenderer::draw(const Camera& camera, const GlTexture& target) {
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadowMaps_.id());
   glUniform1f(kUShadowTexels, static_cast<float>(kShadowMapTexels));
+  glUniform1i(kUVertexColors, vertexColors_ ? 1 : 0);
 
   // 1. The opaque scene; planar mirrors first get a plain surface like everything else.
-  drawOpaqueScene(viewProj, camera.position, kKeepAll, -1);
+  drawOpaqueScene(viewProj, eye, kKeepAll, -1);
   // 2. Each planar mirror, inside its stencil mask.
   glEnable(GL_STENCIL_TEST);
-  for (int k = 0; k < static_cast<int>(mesh_.mirrors.size()); ++k) drawPlanarMirror(k, viewProj, camera.position, far);
+  for (int k = 0; k < static_cast<int>(mesh_.mirrors.size()); ++k) drawPlanarMirror(k, viewProj, eye, far);
   glDisable(GL_STENCIL_TEST);
   // 3. Glass and cut-outs, back to front, blended over what lies behind.
-  if (mesh_.transparentCount) drawTransparent(viewProj, camera.position);
+  if (mesh_.transparentCount) drawTransparent(viewProj, eye);
 
   glDisable(GL_CLIP_DISTANCE0);
   glDisable(GL_DEPTH_TEST);  // leave the state the compute passes and the viewer's blit expect

@@ -33,6 +33,7 @@ struct RasterMesh {
     glm::vec3 normal;      // unit shading normal (the flat normal when the mesh has none)
     glm::vec2 uv;
     glm::vec3 geomNormal;  // unit front-face normal of the triangle
+    glm::vec4 color;       // vertex colour (COLOR_0, linear RGBA; white without)
   };
   struct Batch {
     std::uint32_t material = 0;
@@ -67,6 +68,7 @@ class RasterRenderer {
   void drawTransparent(const glm::mat4& viewProj, const glm::vec3& eye);
 
   std::vector<gpu::Material> materials_;
+  bool vertexColors_ = false;  // the scene has COLOR_0: the vertices' colours multiply the base colour
   RasterMesh mesh_;
   GlBuffer vertexBuffer_, indexBuffer_;
   GlVertexArray vao_;

@@ -263,7 +263,8 @@ void Renderer::prepareMode() {
 std::vector<std::string> Renderer::shaderDefines() const {
   std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_, features_).defines();  // shader_features.cpp
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
-  // under allFeatures (whose CAUSTICA_TEXTURES must not make a scene without texcoords read them).
+  // under allFeatures (whose CAUSTICA_TEXTURES and CAUSTICA_VERTEX_COLORS must not make a scene without
+  // texcoords or colours read them).
   for (const std::string& split : bufferLayout_.defines()) d.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) d.push_back(inst);  // two-level traversal
   return d;
@@ -471,9 +472,12 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   glm::vec3 up = glm::cross(right, fwd);
   gpu::FrameParams fp{};
   fp.camPos = glm::vec4(camera_.position, 1.0f);
-  fp.camRight = glm::vec4(right * tanHalf * aspect, 0.0f);
-  fp.camUp = glm::vec4(up * tanHalf, 0.0f);
-  fp.camForward = glm::vec4(fwd, 0.0f);
+  // Pinhole: the image plane at distance 1; orthographic (camForward.w = 1): the plane through the
+  // eye, orthoHeight above and below it (camera.glsl).
+  const float halfHeight = camera_.orthographic() ? camera_.orthoHeight : tanHalf;
+  fp.camRight = glm::vec4(right * halfHeight * aspect, 0.0f);
+  fp.camUp = glm::vec4(up * halfHeight, 0.0f);
+  fp.camForward = glm::vec4(fwd, camera_.orthographic() ? 1.0f : 0.0f);
   fp.tile = glm::uvec4(0, y0, w, y1 - y0);
 
   prog.use();
@@ -624,9 +628,11 @@ Image Renderer::meansOf(const std::vector<float>& rgba) const {
 const GlTexture& Renderer::denoise() {
   if (!canDenoise()) return accum_;
   if (!denoiser_) denoiser_ = std::make_unique<Denoiser>(library_);  // compiles its programs (not timed)
+  glFinish();  // the work queued before (a sample pass) is not the filter's
   const auto t0 = std::chrono::steady_clock::now();
-  const GlTexture& out = denoiser_->run(accum_, albedo_, normal_);
+  const GlTexture& out = denoiser_->run(accum_, albedo_, normal_);  // returns when the GPU is done
   denoiseMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  denoiseMsTotal_ += denoiseMs_;
   return out;
 }
 

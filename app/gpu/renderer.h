@@ -174,6 +174,8 @@ class Renderer {
   const GlTexture& updateDisplay(const ToneMapSettings& tone, bool denoised = false);
   // Milliseconds the last denoise() took on the GPU (it waits for the GPU to finish); 0 before any.
   double denoiseMs() const { return denoiseMs_; }
+  // The sum of denoiseMs() over every denoise() so far (a frame may filter more than once).
+  double denoiseMsTotal() const { return denoiseMsTotal_; }
   const RenderStats& stats() const { return stats_; }
   const RenderSettings& settings() const { return settings_; }
   const Camera& camera() const { return camera_; }
@@ -242,6 +244,7 @@ class Renderer {
   GlTexture albedo_, normal_; // rgba32f feature sums (CAUSTICA_IMAGE_ALBEDO, CAUSTICA_IMAGE_NORMAL)
   std::unique_ptr<Denoiser> denoiser_;  // made at the first denoise()
   double denoiseMs_ = 0.0;
+  double denoiseMsTotal_ = 0.0;
   std::uint32_t liveTiles_ = 0;  // entries of tileList_ in use while tileListActive_
   int liveTileSize_ = CAUSTICA_WORKGROUP_X;  // side of those tiles in pixels
   bool tileListActive_ = false;

@@ -50,8 +50,7 @@ void uploadArray(std::vector<T>& v, const SplitArray& a, int binding, std::vecto
 }  // namespace
 
 std::vector<std::string> SceneBufferLayout::defines() const {
-  std::vector<std::string> d;
-  if (texcoords) d.push_back("CAUSTICA_TRISHADE_TEXCOORDS");
+  std::vector<std::string> d = shade.defines();
   for (const SplitArray* a : {&nodes, &triGeom, &triShade}) {
     if (a->parts < 2) continue;
     const std::string key = a == &nodes ? "CAUSTICA_NODES" : a == &triGeom ? "CAUSTICA_TRIGEOM" : "CAUSTICA_TRISHADE";
@@ -77,7 +76,7 @@ SceneBufferLayout planSceneBuffers(const GpuScene& g, const GlLimits& limits, co
   l.triShade = {"triangle shading data", 4, g.triangleCount * g.triShadeStride, 0, 1, {}};
   // Nodes and TriGeom are read through buffer textures (bvh_textures.*): one buffer each, bounded by
   // GL_MAX_TEXTURE_BUFFER_SIZE, not by the storage-block size.
-  l.texcoords = g.triShadeStride == gpu::kTriShadeWordsTextured;
+  l.shade = g.triShadeLayout;
   for (SplitArray* a : {&l.nodes, &l.triGeom}) a->perPart = std::max<std::size_t>(a->count, 1);
   planArray(l.triShade, limits.maxStorageBlockSize, g.triShadeStride, scenePath);
   // Materials, the light tree and the texture block are read through buffer textures too

@@ -24,8 +24,8 @@ struct SplitArray {
 
 struct SceneBufferLayout {
   SplitArray nodes, triGeom, triShade;
-  bool texcoords = false;  // the TriShade words hold texcoords (kTriShadeWordsTextured per triangle)
-  // CAUSTICA_TRISHADE_TEXCOORDS when the words hold texcoords; CAUSTICA_<ARRAY>_PARTS=n,
+  TriShadeLayout shade;  // the blocks the TriShade words hold (texcoords, vertex colours, tangents)
+  // CAUSTICA_TRISHADE_TEXCOORDS, _COLORS, _TANGENTS for the blocks the words hold; CAUSTICA_<ARRAY>_PARTS=n,
   // _PART=elements, _BINDING<k>=index for each split array (none when no array is split).
   std::vector<std::string> defines() const;
   int extraBlocks() const { return nodes.parts + triGeom.parts + triShade.parts - 3; }

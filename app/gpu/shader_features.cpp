@@ -12,6 +12,13 @@ namespace {
 bool isGlass(const Material& m) { return m.transmission > 0.0f && m.metallic < 1.0f; }
 bool isDispersive(const Material& m) { return isGlass(m) && m.dispersion > 0.0f; }
 bool misHasLights(const SceneView& v) { return v.gpu.emitterCount > 0 || v.gpu.environment.width > 0; }
+// COLOR_0's alpha reaches the opacity: vertex colours and a used BLEND or MASK material.
+bool hasVertexAlpha(const SceneView& v) {
+  if (v.scene.colors.empty()) return false;
+  for (std::size_t m = 0; m < v.scene.materials.size(); ++m)
+    if (v.usedMaterials[m] && v.scene.materials[m].alphaFromVertices) return true;
+  return false;
+}
 }  // namespace
 
 const std::vector<ShaderFeature>& shaderFeatureTable() {
@@ -37,9 +44,14 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        "a material that reads a texture", [](const Material& m) { return m.readsTextures(); }, nullptr, nullptr,
        nullptr, A::Force},
       {"opacity", "CAUSTICA_OPACITY", K::Scene, "alpha pass-through (BLEND and MASK)",
-       "a material with base-colour alpha < 1 or alpha from its texture",
-       [](const Material& m) { return m.baseColor.a < 1.0f || m.alphaFromTexture; }, nullptr, nullptr, nullptr,
-       A::Force},
+       "a material with base-colour alpha < 1 or alpha from its texture, or a BLEND or MASK material in a "
+       "scene with vertex colours (their alpha)",
+       [](const Material& m) { return m.baseColor.a < 1.0f || m.alphaFromTexture; }, hasVertexAlpha, nullptr,
+       nullptr, A::Force},
+      {"vertex-colors", "CAUSTICA_VERTEX_COLORS", K::Scene,
+       "COLOR_0 multiplies the base colour (and in BLEND and MASK the opacity); tri_shade.glsl's colour block",
+       "a primitive with COLOR_0", nullptr, [](const SceneView& v) { return !v.scene.colors.empty(); }, nullptr,
+       nullptr, A::Force},
       {"environment", "CAUSTICA_ENV", K::Scene, "the environment light and background (glsl/lib/environment.glsl)",
        "an environment that emits, or a background other than it (--env, --background)", nullptr,
        [](const SceneView& v) {

@@ -70,6 +70,24 @@ float denoiseDepthScale(float sigmaDepth, float gradient, int offset, float z) {
   return sigmaDepth * gradient * static_cast<float>(offset) + kDepthRelative * std::abs(z) + kTiny;
 }
 
+// Calls visit(q, kernel weight, q's guide, q's normal) for each of the 8 taps of an à-trous pass around
+// (x, y), `step` pixels apart, that lie in the image and have samples: denoise.comp's tap loop.
+template <typename Visit>
+void forEachTap(const Sums& s, const std::vector<vec4>& guide, int width, int x, int y, int step, Visit visit) {
+  for (int j = -1; j <= 1; ++j)
+    for (int k = -1; k <= 1; ++k) {
+      if (j == 0 && k == 0) continue;
+      const int qx = x + k * step, qy = y + j * step;
+      if (!s.inside(qx, qy)) continue;
+      const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
+      const vec4 gq = guide[q];
+      if (gq.w < 0.0f) continue;
+      const vec3 nqv = denoiseGuideNormal(gq);
+      const float nq[3] = {nqv.x, nqv.y, nqv.z};
+      visit(q, kKernel[std::abs(j)] * kKernel[std::abs(k)], gq, nq);
+    }
+}
+
 }  // namespace
 
 float denoiseNormalWeight(const float np[3], const float nq[3]) {
@@ -203,23 +221,15 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
         float sumW = kKernel[0] * kKernel[0];
         vec3 sumI = sumW * vec3(cp);
         float sumV = sumW * sumW * cp.w;
-        for (int j = -1; j <= 1; ++j)
-          for (int k = -1; k <= 1; ++k) {
-            if (j == 0 && k == 0) continue;
-            const int qx = x + k * step, qy = y + j * step;
-            if (!s.inside(qx, qy)) continue;
-            const vec4 gq = guide[idx(qx, qy)];
-            if (gq.w < 0.0f) continue;
-            const vec4 cq = ping[idx(qx, qy)];
-            const vec3 nqv = denoiseGuideNormal(gq);
-            const float nq[3] = {nqv.x, nqv.y, nqv.z};
-            const float lumDiff = luminance(vec3(ctr) * (vec3(cq) - vec3(cp)));
-            const float ls = denoiseLuminanceScale(settings.sigmaLuminance, cp.w, cq.w, ap, denoiseGuideAlbedo(gq));
-            const float wq = kKernel[std::abs(j)] * kKernel[std::abs(k)] * denoiseTapWeight(np, nq, gp.w, gq.w, ds, lumDiff, ls);
-            sumW += wq;
-            sumI += wq * vec3(cq);
-            sumV += wq * wq * cq.w;
-          }
+        forEachTap(s, guide, w, x, y, step, [&](std::size_t q, float kernel, const vec4& gq, const float nq[3]) {
+          const vec4 cq = ping[q];
+          const float lumDiff = luminance(vec3(ctr) * (vec3(cq) - vec3(cp)));
+          const float ls = denoiseLuminanceScale(settings.sigmaLuminance, cp.w, cq.w, ap, denoiseGuideAlbedo(gq));
+          const float wq = kernel * denoiseTapWeight(np, nq, gp.w, gq.w, ds, lumDiff, ls);
+          sumW += wq;
+          sumI += wq * vec3(cq);
+          sumV += wq * wq * cq.w;
+        });
         const vec3 illum = sumI / sumW;
         pong[i] = vec4(illum, sumV / (sumW * sumW));
         if (!last) continue;
@@ -251,21 +261,12 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
         const float ds = denoiseDepthScale(settings.sigmaDepth, centre[i].w, step, gp.w);
         float sumW = kKernel[0] * kKernel[0];
         vec3 sumR = sumW * vec3(rp);
-        for (int j = -1; j <= 1; ++j)
-          for (int k = -1; k <= 1; ++k) {
-            if (j == 0 && k == 0) continue;
-            const int qx = x + k * step, qy = y + j * step;
-            if (!s.inside(qx, qy)) continue;
-            const vec4 gq = guide[idx(qx, qy)];
-            if (gq.w < 0.0f) continue;
-            const vec4 rq = residual[idx(qx, qy)];
-            const vec3 nqv = denoiseGuideNormal(gq);
-            const float nq[3] = {nqv.x, nqv.y, nqv.z};
-            const float wq = kKernel[std::abs(j)] * kKernel[std::abs(k)] *
-                             denoiseTapWeight(np, nq, gp.w, gq.w, ds, rp.w - rq.w, settings.sigmaResidual * (rp.w + rq.w) + kTiny);
-            sumW += wq;
-            sumR += wq * vec3(rq);
-          }
+        forEachTap(s, guide, w, x, y, step, [&](std::size_t q, float kernel, const vec4& gq, const float nq[3]) {
+          const vec4 rq = residual[q];
+          const float wq = kernel * denoiseTapWeight(np, nq, gp.w, gq.w, ds, rp.w - rq.w, settings.sigmaResidual * (rp.w + rq.w) + kTiny);
+          sumW += wq;
+          sumR += wq * vec3(rq);
+        });
         spread[i] = vec4(sumR / sumW, rp.w);
         if (last) {
           const vec4 acc = s.accum(x, y);

@@ -1,4 +1,4 @@
-// image_io.cpp — PNG through stb_image_write, EXR through tinyexr, PFM by hand.
+// image_io.cpp — PNG through stb_image_write, EXR through OpenEXR (exr_file.h), PFM by hand.
 #include "image/image_io.h"
 
 #include <algorithm>
@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include <stb_image_write.h>
-#include <tinyexr.h>
 
+#include "image/exr_file.h"
 #include "util/error.h"
 
 namespace caustica {
@@ -39,70 +39,31 @@ void writePng(const std::string& path, int width, int height, const std::vector<
 
 namespace {
 
-void writeExr(const std::string& path, const Image& img) {
-  // tinyexr's SaveEXR takes interleaved RGB(A) floats and writes them as 32-bit float channels.
-  const char* err = nullptr;
-  std::vector<float> rgba;
-  if (!img.alpha.empty()) {  // OpenEXR's convention: colour premultiplied by alpha, which rgb already is
-    const size_t n = static_cast<size_t>(img.width) * img.height;
-    rgba.resize(n * 4);
-    for (size_t i = 0; i < n; ++i) {
-      for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = img.rgb[i * 3 + c];
-      rgba[i * 4 + 3] = img.alpha[i];
-    }
+// RGBA floats, interleaved, of an image with alpha.
+std::vector<float> interleaveAlpha(const Image& img) {
+  const size_t n = static_cast<size_t>(img.width) * img.height;
+  std::vector<float> rgba(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = img.rgb[i * 3 + c];
+    rgba[i * 4 + 3] = img.alpha[i];
   }
-  int rc = rgba.empty() ? SaveEXR(img.rgb.data(), img.width, img.height, 3, 0 /* float, not half */, path.c_str(), &err)
-                        : SaveEXR(rgba.data(), img.width, img.height, 4, 0, path.c_str(), &err);
-  if (rc != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "error " + std::to_string(rc);
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot write EXR (" + msg + ")");
-  }
+  return rgba;
 }
 
-// One channel of an EXR file being written: its full name and where its floats are.
-struct ExrChannel {
-  std::string name;
-  const float* data;  // first value; `stride` floats between pixels
-  int stride;
-};
-
-void writeExrChannels(const std::string& path, int width, int height, std::vector<ExrChannel> channels) {
-  // OpenEXR keeps a file's channels sorted by name (its channel list is a map): write them so.
-  std::sort(channels.begin(), channels.end(), [](const ExrChannel& a, const ExrChannel& b) { return a.name < b.name; });
-  const size_t n = static_cast<size_t>(width) * height;
-  std::vector<std::vector<float>> planes(channels.size(), std::vector<float>(n));
-  std::vector<unsigned char*> planePtrs(channels.size());
-  std::vector<EXRChannelInfo> infos(channels.size());
-  std::vector<int> types(channels.size(), TINYEXR_PIXELTYPE_FLOAT);
-  for (size_t c = 0; c < channels.size(); ++c) {
-    if (channels[c].name.size() >= sizeof infos[c].name) throw Error(path + ": EXR channel name too long: " + channels[c].name);
-    std::memset(&infos[c], 0, sizeof infos[c]);
-    std::memcpy(infos[c].name, channels[c].name.c_str(), channels[c].name.size() + 1);
-    for (size_t i = 0; i < n; ++i) planes[c][i] = channels[c].data[i * static_cast<size_t>(channels[c].stride)];
-    planePtrs[c] = reinterpret_cast<unsigned char*>(planes[c].data());
+// The image's own layer: linear float R, G, B (+ A: OpenEXR's convention is colour premultiplied by
+// alpha, which rgb already is).
+ImageLayer mainLayer(const Image& img) {
+  ImageLayer main;
+  main.channels = {"R", "G", "B"};
+  main.data = img.rgb;
+  if (!img.alpha.empty()) {
+    main.channels.push_back("A");
+    main.data = interleaveAlpha(img);
   }
-  EXRHeader header;
-  InitEXRHeader(&header);
-  EXRImage image;
-  InitEXRImage(&image);
-  image.num_channels = static_cast<int>(channels.size());
-  image.images = planePtrs.data();
-  image.width = width;
-  image.height = height;
-  header.num_channels = static_cast<int>(channels.size());
-  header.channels = infos.data();
-  header.pixel_types = types.data();
-  header.requested_pixel_types = types.data();
-  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  const char* err = nullptr;
-  const int rc = SaveEXRImageToFile(&image, &header, path.c_str(), &err);
-  if (rc != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "error " + std::to_string(rc);
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot write EXR (" + msg + ")");
-  }
+  return main;
 }
+
+void writeExr(const std::string& path, const Image& img) { writeExrLayers(path, img.width, img.height, {mainLayer(img)}); }
 
 void writePfm(const std::string& path, const Image& img) {
   std::ofstream f(path, std::ios::binary);
@@ -115,18 +76,30 @@ void writePfm(const std::string& path, const Image& img) {
 }
 
 Image readExr(const std::string& path) {
-  float* rgba = nullptr;
   int w = 0, h = 0;
-  const char* err = nullptr;
-  if (LoadEXR(&rgba, &w, &h, path.c_str(), &err) != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "unreadable";
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot read EXR (" + msg + ")");
+  const std::vector<ImageLayer> layers = readExrLayers(path, w, h);
+  const ImageLayer* layer = colorLayer(layers);
+  if (!layer) {
+    std::string names;
+    for (const ImageLayer& l : layers)
+      for (const std::string& c : l.channels) names += (names.empty() ? "" : ", ") + (l.name.empty() ? c : l.name + "." + c);
+    throw Error(path + ": the EXR file has no R, G, B or Y channels (it has: " + (names.empty() ? "none" : names) + ")");
   }
-  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
-  for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
-    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = rgba[i * 4 + c];
-  std::free(rgba);
+  const auto find = [&](const char* name) -> int {
+    for (std::size_t c = 0; c < layer->channels.size(); ++c)
+      if (layer->channels[c] == name) return int(c);
+    return -1;
+  };
+  const std::size_t n = layer->channels.size(), pixels = std::size_t(w) * std::size_t(h);
+  const int y = find("Y");
+  const int rgb[3] = {find("R") >= 0 ? find("R") : y, find("G") >= 0 ? find("G") : y, find("B") >= 0 ? find("B") : y};
+  const int a = find("A");
+  Image img{w, h, std::vector<float>(pixels * 3)};
+  if (a >= 0) img.alpha.resize(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer->data[i * n + std::size_t(rgb[c])];
+    if (a >= 0) img.alpha[i] = layer->data[i * n + std::size_t(a)];
+  }
   return img;
 }
 
@@ -151,74 +124,14 @@ Image readPfm(const std::string& path) {
 }  // namespace
 
 void writeExrLayers(const std::string& path, const Image& image, const std::vector<ImageLayer>& layers) {
-  const size_t n = static_cast<size_t>(image.width) * image.height;
-  std::vector<ExrChannel> channels;
-  const char* rgb[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c) channels.push_back({rgb[c], image.rgb.data() + c, 3});
-  if (!image.alpha.empty()) channels.push_back({"A", image.alpha.data(), 1});
+  std::vector<ImageLayer> all = {mainLayer(image)};
   std::set<std::string> names;
   for (const ImageLayer& l : layers) {
     if (l.name.empty() || !names.insert(l.name).second || l.channels.empty())
       throw Error(path + ": internal: EXR layer '" + l.name + "' is unnamed, repeated or has no channels");
-    if (l.data.size() != n * l.channels.size())
-      throw Error(path + ": internal: EXR layer '" + l.name + "' does not match the image size");
-    for (size_t c = 0; c < l.channels.size(); ++c)
-      channels.push_back({l.name + "." + l.channels[c], l.data.data() + c, static_cast<int>(l.channels.size())});
+    all.push_back(l);
   }
-  writeExrChannels(path, image.width, image.height, channels);
-}
-
-std::vector<ImageLayer> readExrLayers(const std::string& path, int& width, int& height) {
-  EXRVersion version;
-  const char* err = nullptr;
-  auto fail = [&](const char* what) {
-    std::string msg = err ? err : what;
-    if (err) FreeEXRErrorMessage(err);
-    return Error(path + ": cannot read EXR (" + msg + ")");
-  };
-  if (ParseEXRVersionFromFile(&version, path.c_str()) != TINYEXR_SUCCESS) throw fail("not an EXR file");
-  EXRHeader header;
-  InitEXRHeader(&header);
-  if (ParseEXRHeaderFromFile(&header, &version, path.c_str(), &err) != TINYEXR_SUCCESS) throw fail("bad header");
-  for (int c = 0; c < header.num_channels; ++c) header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
-  EXRImage image;
-  InitEXRImage(&image);
-  if (LoadEXRImageFromFile(&image, &header, path.c_str(), &err) != TINYEXR_SUCCESS) {
-    FreeEXRHeader(&header);
-    throw fail("unreadable");
-  }
-  width = image.width;
-  height = image.height;
-  std::vector<ImageLayer> layers;
-  const size_t n = static_cast<size_t>(width) * height;
-  if (image.images == nullptr) {  // tiled files: not written by caustica
-    FreeEXRImage(&image);
-    FreeEXRHeader(&header);
-    throw Error(path + ": cannot read EXR (tiled files are not supported here)");
-  }
-  for (int c = 0; c < header.num_channels; ++c) {
-    const std::string full = header.channels[c].name;
-    const size_t dot = full.rfind('.');
-    const std::string layer = dot == std::string::npos ? "" : full.substr(0, dot);
-    const std::string channel = dot == std::string::npos ? full : full.substr(dot + 1);
-    auto it = std::find_if(layers.begin(), layers.end(), [&](const ImageLayer& l) { return l.name == layer; });
-    if (it == layers.end()) it = layers.insert(layers.end(), ImageLayer{layer, {}, {}});
-    it->channels.push_back(channel);
-  }
-  for (ImageLayer& l : layers) {
-    l.data.resize(n * l.channels.size());
-    for (size_t k = 0; k < l.channels.size(); ++k) {
-      const std::string full = l.name.empty() ? l.channels[k] : l.name + "." + l.channels[k];
-      for (int c = 0; c < header.num_channels; ++c)
-        if (full == header.channels[c].name) {
-          const float* plane = reinterpret_cast<const float*>(image.images[c]);
-          for (size_t i = 0; i < n; ++i) l.data[i * l.channels.size() + k] = plane[i];
-        }
-    }
-  }
-  FreeEXRImage(&image);
-  FreeEXRHeader(&header);
-  return layers;
+  writeExrLayers(path, image.width, image.height, all);
 }
 
 std::vector<float> unpremultiplied(const Image& image) {

@@ -1,4 +1,4 @@
-// environment.cpp — environment maps (.hdr through stb_image, .exr through tinyexr), uniform skies,
+// environment.cpp — environment maps (.hdr through stb_image, .exr through OpenEXR), uniform skies,
 // and the text of --env / --background.
 #include "scene/environment.h"
 

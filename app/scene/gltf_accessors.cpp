@@ -1,5 +1,6 @@
 // gltf_accessors.cpp — glTF accessors and buffer views: bounds-checked byte ranges, component types
-// and their decoding (normalisation, sparse substitution) into doubles.
+// and their decoding (normalisation, sparse substitution) into doubles; Draco-decoded attributes
+// stand in for their accessors' data.
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -23,11 +24,38 @@ const char* componentName(int type) {
   }
 }
 
+}  // namespace
+
+namespace {
+constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE, kUbyte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+              kShort = TINYGLTF_COMPONENT_TYPE_SHORT, kUshort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+              kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+}  // namespace
+
+const Formats& attributeFormats(VertexAttribute a, bool quantized) {
+  static const Formats kFloatOnly = {{kFloat, false}};
+  static const Formats kAny = {{kFloat, false}, {kByte, false},  {kByte, true},   {kUbyte, false}, {kUbyte, true},
+                               {kShort, false}, {kShort, true}, {kUshort, false}, {kUshort, true}};
+  static const Formats kNormalized = {{kFloat, false}, {kUbyte, true}, {kUshort, true}};
+  static const Formats kSignedNormalized = {{kFloat, false}, {kByte, true}, {kShort, true}};
+  switch (a) {
+    case VertexAttribute::Position: return quantized ? kAny : kFloatOnly;
+    case VertexAttribute::Normal:
+    case VertexAttribute::Tangent: return quantized ? kSignedNormalized : kFloatOnly;
+    case VertexAttribute::Texcoord: return quantized ? kAny : kNormalized;
+    case VertexAttribute::Color: return kNormalized;
+  }
+  return kFloatOnly;
+}
+const Formats kIndexFormats = {{kUbyte, false}, {kUshort, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false}};
+
 std::string formatName(int componentType, bool normalized) {
   const char* name = componentName(componentType);
   return std::string(normalized ? "normalized " : "") +
          (name ? name : "invalid (" + std::to_string(componentType) + ")");
 }
+
+namespace {
 
 const char* typeName(int type) {
   switch (type) {
@@ -56,20 +84,12 @@ std::size_t componentSize(int type) {
 
 // One component, little-endian, with glTF's normalisation rules for integer types.
 double readComponent(const unsigned char* p, int type, bool normalized) {
+  double v = 0.0;
   switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      const double v = static_cast<std::int8_t>(p[0]);
-      return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      const double v = static_cast<std::int16_t>(std::uint16_t(p[0] | p[1] << 8));
-      return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      const double v = std::uint16_t(p[0] | p[1] << 8);
-      return normalized ? v / 65535.0 : v;
-    }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: v = static_cast<std::int8_t>(p[0]); break;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = p[0]; break;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: v = static_cast<std::int16_t>(std::uint16_t(p[0] | p[1] << 8)); break;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: v = std::uint16_t(p[0] | p[1] << 8); break;
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return readU32(p);
     case TINYGLTF_COMPONENT_TYPE_FLOAT: {
       const std::uint32_t bits = readU32(p);
@@ -79,6 +99,7 @@ double readComponent(const unsigned char* p, int type, bool normalized) {
     }
     default: return 0.0;
   }
+  return normalized ? normalizedValue(v, type) : v;
 }
 
 }  // namespace
@@ -93,6 +114,16 @@ bool rangeFits(std::uint64_t offset, std::uint64_t stride, std::uint64_t count, 
 
 std::uint32_t readU32(const unsigned char* p) {
   return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+}
+
+double normalizedValue(double raw, int componentType) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return std::max(raw / 127.0, -1.0);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return raw / 255.0;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return std::max(raw / 32767.0, -1.0);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return raw / 65535.0;
+    default: return raw;
+  }
 }
 
 SceneBuilder::ViewBytes SceneBuilder::bufferView(int index, const std::string& at) const {
@@ -111,10 +142,8 @@ SceneBuilder::ViewBytes SceneBuilder::bufferView(int index, const std::string& a
   return {buffer.data.data() + view.byteOffset, view.byteLength, view.byteStride};
 }
 
-// Reads accessor `index` as doubles (count x components), applying normalisation and sparse
-// substitution; `allowed` lists the (componentType, normalized) pairs legal for this use.
-std::vector<double> SceneBuilder::readAccessor(int index, int type, std::initializer_list<Format> allowed,
-                                               const std::string& use) {
+const tinygltf::Accessor& SceneBuilder::checkedAccessor(int index, int type, const Formats& allowed,
+                                                        const std::string& use) const {
   if (index < 0 || std::size_t(index) >= model_.accessors.size())
     fail(use + " refers to accessor " + std::to_string(index) + ", but the file has " + str(model_.accessors.size()) +
          " accessors");
@@ -129,6 +158,15 @@ std::vector<double> SceneBuilder::readAccessor(int index, int type, std::initial
   }
   if (!legal)
     fail(at + " has component type " + formatName(acc.componentType, acc.normalized) + "; allowed: " + legalList);
+  return acc;
+}
+
+// Reads accessor `index` as doubles (count x components), applying normalisation and sparse
+// substitution; `allowed` lists the (componentType, normalized) pairs legal for this use.
+std::vector<double> SceneBuilder::readAccessor(int index, int type, const Formats& allowed,
+                                               const std::string& use) {
+  const tinygltf::Accessor& acc = checkedAccessor(index, type, allowed, use);
+  const std::string at = "accessors[" + str(std::uint64_t(index)) + "] (" + use + ")";
   const std::size_t components = std::size_t(tinygltf::GetNumComponentsInType(std::uint32_t(type)));
   const std::size_t size = componentSize(acc.componentType);
   const std::size_t elem = components * size;
@@ -194,13 +232,20 @@ std::vector<double> SceneBuilder::readAccessor(int index, int type, std::initial
 }
 
 std::vector<double> SceneBuilder::readAttribute(const tinygltf::Primitive& prim, const char* name, int type,
-                                                std::initializer_list<Format> allowed, std::size_t vertexCount,
+                                                const Formats& allowed, std::size_t vertexCount,
                                                 const std::string& at) {
   const auto it = prim.attributes.find(name);
   if (it == prim.attributes.end()) return {};
-  std::vector<double> values = readAccessor(it->second, type, allowed, at + " " + name);
+  std::vector<double> values;
+  const auto decoded = draco_ ? draco_->attributes.find(name) : std::map<std::string, std::vector<double>>::const_iterator();
+  if (draco_ && decoded != draco_->attributes.end()) {
+    checkedAccessor(it->second, type, allowed, at + " " + name);  // the accessor still declares type and format
+    values = decoded->second;
+  } else {
+    values = readAccessor(it->second, type, allowed, at + " " + name);
+  }
   const std::size_t components = std::size_t(tinygltf::GetNumComponentsInType(std::uint32_t(type)));
-  if (values.size() != vertexCount * components)
+  if (vertexCount != kAnyCount && values.size() != vertexCount * components)
     fail(at + ": " + name + " has " + str(values.size() / components) + " elements but POSITION has " +
          str(vertexCount));
   return values;

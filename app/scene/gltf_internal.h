@@ -72,8 +72,38 @@ bool isSupportedExtension(const std::string& name);
 // would not check (types, indices, byte ranges, buffer sources), external references that lead
 // outside access.folder and buffers whose byteLengths add up to more than options.maxBufferBytes.
 // binary: jsonText is a GLB's JSON chunk. Throws Error("PATH: ...").
-void checkJson(const std::string& path, const std::string& jsonText, const FileAccess& access, bool binary,
-               const LoadOptions& options);
+// What the document holds that tinygltf cannot load as it stands (compressed geometry).
+struct JsonFacts {
+  std::vector<std::size_t> fallbackBuffers;  // buffers EXT_meshopt_compression marks as fallback (no data needed)
+  struct DracoIndices {
+    std::size_t mesh, primitive;
+    int accessor;
+  };
+  std::vector<DracoIndices> dracoIndices;  // KHR_draco_mesh_compression primitives' indices accessors
+  bool needsRewrite() const { return !fallbackBuffers.empty() || !dracoIndices.empty(); }
+};
+JsonFacts checkJson(const std::string& path, const std::string& jsonText, const FileAccess& access, bool binary,
+                    const LoadOptions& options);
+
+// ---- compressed geometry (gltf_compression.cpp) --------------------------------------------------
+// The JSON text as tinygltf can load it: each EXT_meshopt_compression fallback buffer replaced by a
+// one-byte placeholder (tinygltf would look for data such a buffer need not have; decodeMeshoptViews
+// decodes its views from their compressed source), and the indices of Draco primitives left out
+// (tinygltf refuses an indices accessor without a bufferView; restoreDracoIndices puts them back).
+std::string tinygltfJson(const std::string& jsonText, const JsonFacts& facts);
+void restoreDracoIndices(tinygltf::Model& model, const JsonFacts& facts);
+// EXT_meshopt_compression: decodes every compressed buffer view (the meshopt vertex and index codecs
+// and the octahedral, quaternion and exponential filters) into a buffer of its own and points the view
+// at it. Refuses corrupt data, views of a fallback buffer that are not compressed, and decoded bytes
+// beyond options.maxBufferBytes. Throws Error("PATH: ...").
+void decodeMeshoptViews(const std::string& path, tinygltf::Model& model, const std::vector<std::size_t>& fallback,
+                        const LoadOptions& options);
+
+// The object of extension `name` in an extensions map, or nullptr (absent, or not an object).
+inline const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
+  const auto it = map.find(name);
+  return it == map.end() || !it->second.IsObject() ? nullptr : &it->second;
+}
 
 // ---- byte access (gltf_accessors.cpp) ------------------------------------------------------------
 // True when `count` elements of `elem` bytes, `stride` bytes apart, starting at `offset`, lie inside
@@ -88,6 +118,19 @@ struct Format {
   int componentType;
   bool normalized;
 };
+using Formats = std::vector<Format>;
+// The storages glTF allows for a vertex attribute: FLOAT; TEXCOORD_n and COLOR_n also normalized
+// unsigned byte and short. With KHR_mesh_quantization (`quantized`) also integer and normalized
+// POSITION and TEXCOORD of every 8- and 16-bit type, and normalized byte and short NORMAL and TANGENT.
+enum class VertexAttribute { Position, Normal, Tangent, Texcoord, Color };
+const Formats& attributeFormats(VertexAttribute attribute, bool quantized);
+extern const Formats kIndexFormats;
+constexpr std::size_t kAnyCount = ~std::size_t(0);  // readAttribute: no vertex count to match (POSITION itself)
+// "normalized UNSIGNED_BYTE", "FLOAT", ...
+std::string formatName(int componentType, bool normalized);
+// A stored integer component as glTF normalizes it (byte / 127 clamped to -1, ubyte / 255, ...);
+// FLOAT and UNSIGNED_INT values unchanged.
+double normalizedValue(double raw, int componentType);
 
 // ---- image decoding (gltf_materials.cpp) ---------------------------------------------------------
 // Decodes every image to 8-bit RGBA with stb_image. A failure is recorded rather than returned, so
@@ -145,7 +188,11 @@ class SceneBuilder {
     warn(what);
   }
 
-  void warnUnsupportedExtensions();
+  // Everything the file holds that caustica does not render, as one warning line (gltf_unsupported.cpp);
+  // notRendered adds an entry found elsewhere (a material's textures).
+  void warnNotRendered();
+  void notRendered(const std::string& what);
+  std::vector<std::string> notRendered_;
 
   // ---- materials (gltf_materials.cpp) ----
   double unit(double v, const std::string& what);
@@ -203,6 +250,20 @@ class SceneBuilder {
   void addLight(int index, const glm::dmat4& world, const std::string& at);
 
   // ---- accessors (gltf_accessors.cpp) ----
+  // KHR_draco_mesh_compression: a primitive's decoded attributes (glTF names) and indices, each as
+  // readAccessor would return them from uncompressed data (gltf_compression.cpp).
+  struct DracoPrimitive {
+    std::map<std::string, std::vector<double>> attributes;
+    std::vector<double> indices;
+    bool indexed = false;
+  };
+  DracoPrimitive decodeDraco(const tinygltf::Primitive& prim, const std::string& at);
+  const DracoPrimitive* draco_ = nullptr;  // the primitive being assembled, when Draco-compressed
+  bool quantized_ = false;                 // KHR_mesh_quantization is used: attributeFormats' wider list
+  // The accessor's type and (componentType, normalized) checked against the legal ones for `use`.
+  const tinygltf::Accessor& checkedAccessor(int index, int type, const Formats& allowed,
+                                            const std::string& use) const;
+
   struct ViewBytes {
     const unsigned char* data = nullptr;
     std::uint64_t length = 0;
@@ -210,9 +271,9 @@ class SceneBuilder {
   };
 
   ViewBytes bufferView(int index, const std::string& at) const;
-  std::vector<double> readAccessor(int index, int type, std::initializer_list<Format> allowed, const std::string& use);
+  std::vector<double> readAccessor(int index, int type, const Formats& allowed, const std::string& use);
   std::vector<double> readAttribute(const tinygltf::Primitive& prim, const char* name, int type,
-                                    std::initializer_list<Format> allowed, std::size_t vertexCount,
+                                    const Formats& allowed, std::size_t vertexCount,
                                     const std::string& at);
 
   // ---- meshes (gltf_nodes.cpp) ----
@@ -238,6 +299,8 @@ class SceneBuilder {
   std::map<std::pair<int, std::vector<float>>, int> transformMap_;
   int defaultMaterial_ = -1;
   bool keepUv_ = false;          // some material reads a texture: Scene::texcoords kept (keepsTexcoords)
+  bool keepColors_ = false;      // some primitive so far has COLOR_0: Scene::colors kept
+  bool keepTangents_ = false;    // some normal-mapped primitive so far has TANGENT: Scene::tangents kept
   std::size_t degenerate_ = 0;   // zero-area triangles dropped
   std::size_t badNormals_ = 0;   // triangles whose vertex normals were unusable
   std::size_t candidates_ = 0;   // triangles assembled so far, degenerate ones included

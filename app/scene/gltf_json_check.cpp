@@ -22,7 +22,8 @@ const char* const kSupportedExtensions[] = {
     "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
     "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_materials_specular",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit", "KHR_texture_transform",
-    "KHR_lights_punctual", "EXT_mesh_gpu_instancing"};
+    "KHR_lights_punctual", "EXT_mesh_gpu_instancing", "EXT_texture_webp", "KHR_mesh_quantization",
+    "EXT_meshopt_compression", "KHR_draco_mesh_compression"};
 
 std::string supportedExtensionList() {
   std::string out;
@@ -60,7 +61,7 @@ class JsonChecker {
   JsonChecker(const std::string& path, const FileAccess& access, bool binary, const LoadOptions& options)
       : path_(path), access_(access), binary_(binary), options_(options) {}
 
-  void check(const Json& root) {
+  JsonFacts check(const Json& root) {
     if (!root.is_object()) fail("the top-level JSON value is " + describe(root) + ", not an object");
     checkAsset(root);
     checkExtensionLists(root);
@@ -77,19 +78,25 @@ class JsonChecker {
     // All declared byteLengths are added up before any buffer's file is looked at.
     std::uint64_t bufferBytes = 0;
     forEach(root, "buffers", [&](const Json& o, const std::string& at) { checkBufferLength(o, at, bufferBytes); });
-    forEach(root, "buffers", [&](const Json& o, const std::string& at) { checkBuffer(o, at); });
+    std::size_t bufferIndex = 0;
+    forEach(root, "buffers", [&](const Json& o, const std::string& at) { checkBuffer(o, at, bufferIndex++); });
     forEach(root, "bufferViews", [&](const Json& o, const std::string& at) { checkBufferView(root, o, at); });
     forEach(root, "images", [&](const Json& o, const std::string& at) { checkImage(root, o, at); });
+    std::size_t meshIndex = 0;
+    forEach(root, "meshes", [&](const Json& o, const std::string& at) { checkDraco(root, o, at, meshIndex++); });
     forEach(root, "samplers", [&](const Json& o, const std::string& at) {
       for (const char* key : {"magFilter", "minFilter", "wrapS", "wrapT"}) index(o, at, key);
     });
     forEach(root, "textures", [&](const Json& o, const std::string& at) {
       index(o, at, "sampler");
       index(o, at, "source");
-      object(o, at, "extensions");
+      if (const Json* ext = object(o, at, "extensions"))
+        if (const Json* webp = object(*ext, join(at, "extensions"), "EXT_texture_webp"))
+          reference(root, *webp, join(at, "extensions.EXT_texture_webp"), "source", "images", true);
     });
     forEach(root, "materials", [&](const Json& o, const std::string& at) { checkMaterial(o, at); });
     forEach(root, "cameras", [&](const Json& o, const std::string& at) { checkCamera(o, at); });
+    return facts_;
   }
 
  private:
@@ -130,6 +137,8 @@ class JsonChecker {
 
   // A non-negative integer no larger than `max`.
   void checkIndexValue(const Json& v, const std::string& where, std::uint64_t max) const {
+    if (v.is_number_integer() && !v.is_number_unsigned() && v.get<std::int64_t>() < 0)
+      fail(where + " is " + std::to_string(v.get<std::int64_t>()) + "; it must be a non-negative integer");
     bool ok = v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0);
     expect(ok, v, where, "a non-negative integer");
     if (v.get<std::uint64_t>() > max)
@@ -336,9 +345,11 @@ class JsonChecker {
         checkIndexValue(item.value(), where, kMaxIndex);
         checkReference(root, item.value(), where, "accessors");
       }
+      const Json* pext = object(p, pat, "extensions");
+      const bool draco = pext && pext->contains("KHR_draco_mesh_compression");
       if (const Json* indices = reference(root, p, pat, "indices", "accessors")) {
         const Json& accessor = (*find(root, "accessors"))[indices->get<std::size_t>()];
-        if (accessor.is_object() && !accessor.contains("bufferView"))
+        if (accessor.is_object() && !accessor.contains("bufferView") && !draco)
           fail(join(pat, "indices") + ": accessors[" + str(indices->get<std::uint64_t>()) +
                "] has no bufferView (index data must be stored)");
       }
@@ -391,8 +402,19 @@ class JsonChecker {
   }
 
   // Buffer sources are checked here so that the messages name the buffer (tinygltf's do not).
-  void checkBuffer(const Json& o, const std::string& at) const {
+  void checkBuffer(const Json& o, const std::string& at, std::size_t index) {
     const auto length = o["byteLength"].get<std::uint64_t>();
+    // EXT_meshopt_compression: a fallback buffer holds what its compressed views decode to; a loader
+    // that decodes them needs none of its data (withoutFallbackBuffers), so its uri is not followed.
+    if (const Json* ext = object(o, at, "extensions"))
+      if (const Json* meshopt = object(*ext, join(at, "extensions"), "EXT_meshopt_compression")) {
+        boolean(*meshopt, join(at, "extensions.EXT_meshopt_compression"), "fallback");
+        if (meshopt->value("fallback", false)) {
+          facts_.fallbackBuffers.push_back(index);
+          string(o, at, "uri");
+          return;
+        }
+      }
     const Json* uriValue = string(o, at, "uri");
     if (!uriValue) {
       if (!binary_) fail(join(at, "uri") + " is missing (only a .glb file's buffer may omit it)");
@@ -455,6 +477,42 @@ class JsonChecker {
     if (!rangeFits(offset, 0, 1, length, bufferLength))
       fail(at + " (byteOffset " + str(offset) + ", byteLength " + str(length) + ") overruns buffers[" + str(buffer) +
            "] (" + str(bufferLength) + " bytes)");
+    if (const Json* ext = object(o, at, "extensions"))
+      if (const Json* m = object(*ext, join(at, "extensions"), "EXT_meshopt_compression")) {
+        // The compressed source: its buffer range (the modes, strides and filters: decodeMeshoptViews).
+        const std::string mat = join(at, "extensions.EXT_meshopt_compression");
+        const auto source = reference(root, *m, mat, "buffer", "buffers", true)->get<std::uint64_t>();
+        const Json* so = index(*m, mat, "byteOffset", false, kMaxByteCount);
+        const auto sourceOffset = so ? so->get<std::uint64_t>() : 0;
+        const auto sourceLength = index(*m, mat, "byteLength", true, kMaxByteCount)->get<std::uint64_t>();
+        index(*m, mat, "byteStride", true, 256);
+        index(*m, mat, "count", true, kMaxByteCount);
+        string(*m, mat, "mode", true);
+        string(*m, mat, "filter");
+        const auto sourceBufferLength = (*buffers)[source]["byteLength"].get<std::uint64_t>();
+        if (!rangeFits(sourceOffset, 0, 1, sourceLength, sourceBufferLength))
+          fail(mat + " (byteOffset " + str(sourceOffset) + ", byteLength " + str(sourceLength) + ") overruns buffers[" +
+               str(source) + "] (" + str(sourceBufferLength) + " bytes)");
+      }
+  }
+
+  // KHR_draco_mesh_compression on a primitive: its bufferView and the attributes' Draco ids.
+  void checkDraco(const Json& root, const Json& o, const std::string& at, std::size_t mesh) {
+    const Json& prims = o["primitives"];
+    for (std::size_t i = 0; i < prims.size(); ++i) {
+      const std::string pat = join(at, "primitives") + "[" + str(i) + "]";
+      const Json* ext = find(prims[i], "extensions");
+      if (!ext) continue;
+      const Json* d = object(*ext, join(pat, "extensions"), "KHR_draco_mesh_compression");
+      if (!d) continue;
+      const std::string dat = join(pat, "extensions.KHR_draco_mesh_compression");
+      reference(root, *d, dat, "bufferView", "bufferViews", true);
+      const Json* attributes = object(*d, dat, "attributes", true);
+      for (const auto& item : attributes->items())
+        checkIndexValue(item.value(), join(dat, "attributes") + "." + oneLine(item.key()), kMaxIndex);
+      if (const Json* indices = find(prims[i], "indices"))
+        facts_.dracoIndices.push_back({mesh, i, indices->get<int>()});
+    }
   }
 
   void checkImage(const Json& root, const Json& o, const std::string& at) const {
@@ -470,6 +528,12 @@ class JsonChecker {
       if (view->get<std::uint64_t>() >= viewCount)
         fail(join(at, "bufferView") + " is " + str(view->get<std::uint64_t>()) + ", but the file has " +
              str(viewCount) + " buffer views");
+      // tinygltf decodes images from their buffer's data, which a fallback buffer does not hold.
+      const Json& v = (*views)[view->get<std::size_t>()];
+      const std::size_t buffer = v["buffer"].get<std::size_t>();
+      if (std::find(facts_.fallbackBuffers.begin(), facts_.fallbackBuffers.end(), buffer) != facts_.fallbackBuffers.end())
+        fail(at + " lies in buffers[" + str(buffer) +
+             "], an EXT_meshopt_compression fallback buffer, which holds no data");
     }
   }
 
@@ -571,10 +635,19 @@ class JsonChecker {
       number(*p, pat, "znear");
       number(*p, pat, "zfar");
     }
-    object(o, at, "orthographic");
+    if (const Json* ortho = object(o, at, "orthographic")) {
+      const std::string oat = join(at, "orthographic");
+      for (const char* key : {"xmag", "ymag"})
+        if (number(*ortho, oat, key, true)->get<double>() == 0.0) fail(join(oat, key) + " is 0; it must not be");
+      const double znear = number(*ortho, oat, "znear", true)->get<double>();
+      const double zfar = number(*ortho, oat, "zfar", true)->get<double>();
+      if (!(znear >= 0.0) || !(zfar > znear))
+        fail(oat + " has znear " + num(znear) + " and zfar " + num(zfar) + "; they must satisfy 0 <= znear < zfar");
+    }
   }
 
   std::string path_;
+  JsonFacts facts_;  // fallback buffers (checkBuffer), Draco primitives' indices (checkDraco)
   const FileAccess& access_;
   bool binary_;
   const LoadOptions& options_;
@@ -588,8 +661,8 @@ bool isSupportedExtension(const std::string& name) {
   return false;
 }
 
-void checkJson(const std::string& path, const std::string& jsonText, const FileAccess& access, bool binary,
-               const LoadOptions& options) {
+JsonFacts checkJson(const std::string& path, const std::string& jsonText, const FileAccess& access, bool binary,
+                    const LoadOptions& options) {
   if (jsonDepth(jsonText.data(), jsonText.size(), kMaxJsonDepth) > kMaxJsonDepth)
     throw Error(path + ": JSON is nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
   Json document;
@@ -602,7 +675,7 @@ void checkJson(const std::string& path, const std::string& jsonText, const FileA
     throw Error(path + ": invalid JSON: " + oneLine(what));
   }
   try {
-    JsonChecker(path, access, binary, options).check(document);
+    return JsonChecker(path, access, binary, options).check(document);
   } catch (const Json::exception& e) {  // a check that assumed a JSON type it had not verified
     throw Error(path + ": unexpected JSON structure: " + oneLine(e.what()));
   }

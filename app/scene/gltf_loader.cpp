@@ -158,6 +158,28 @@ std::string glbJson(const std::string& path, const std::vector<unsigned char>& b
   return std::string(reinterpret_cast<const char*>(&bytes[20]), jsonLength);
 }
 
+// The GLB `bytes` (checked by glbJson) with its JSON chunk replaced by `json`, the BIN chunk kept.
+std::vector<unsigned char> glbWithJson(const std::vector<unsigned char>& bytes, const std::string& json) {
+  const std::uint64_t length = readU32(&bytes[8]), binAt = 20 + std::uint64_t(readU32(&bytes[12]));
+  std::string padded = json;
+  while (padded.size() % 4 != 0) padded += ' ';
+  const std::uint64_t total = 20 + padded.size() + (length - binAt);
+  unsigned char header[20];
+  std::memcpy(header, bytes.data(), 8);  // magic and version
+  const auto put32 = [&](std::size_t at, std::uint64_t v) {
+    for (int k = 0; k < 4; ++k) header[at + std::size_t(k)] = static_cast<unsigned char>(v >> (8 * k));
+  };
+  put32(8, total);
+  put32(12, padded.size());
+  put32(16, 0x4E4F534Au);
+  std::vector<unsigned char> out(static_cast<std::size_t>(total));
+  std::copy(header, header + 20, out.begin());
+  std::copy(padded.begin(), padded.end(), out.begin() + 20);
+  std::copy(bytes.begin() + std::ptrdiff_t(binAt), bytes.begin() + std::ptrdiff_t(length),
+            out.begin() + 20 + std::ptrdiff_t(padded.size()));
+  return out;
+}
+
 }  // namespace
 }  // namespace gltf
 
@@ -210,7 +232,11 @@ SceneFile::SceneFile(const std::string& path, const LoadOptions& options) : doc_
     access.folder = std::filesystem::canonical(access.baseDir.empty() ? "." : access.baseDir, ec);
     if (ec) throw Error(path + ": cannot resolve the scene's folder (" + oneLine(ec.message()) + ")");
   }
-  checkJson(path, jsonText, access, binary, options);
+  const JsonFacts facts = checkJson(path, jsonText, access, binary, options);
+  // Compressed geometry that tinygltf cannot load as it stands: a rewritten document.
+  std::vector<unsigned char> rewrittenGlb;
+  const std::string loadJson = facts.needsRewrite() ? tinygltfJson(jsonText, facts) : jsonText;
+  if (binary && facts.needsRewrite()) rewrittenGlb = glbWithJson(bytes, loadJson);
 
   tinygltf::Model& model = doc_->model;
   ImageLog& imageLog = doc_->imageLog;
@@ -220,15 +246,21 @@ SceneFile::SceneFile(const std::string& path, const LoadOptions& options) : doc_
     loader.SetImageLoader(decodeImage, &imageLog);
     loader.SetFsCallbacks({fsFileExists, fsExpandFilePath, fsReadWholeFile, fsWriteWholeFile, &access});
     std::string err, warn;
-    const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                                         static_cast<unsigned int>(bytes.size()), access.baseDir)
-                           : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(),
-                                                        static_cast<unsigned int>(jsonText.size()), access.baseDir);
+    const std::vector<unsigned char>& glb = rewrittenGlb.empty() ? bytes : rewrittenGlb;
+    const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, glb.data(),
+                                                         static_cast<unsigned int>(glb.size()), access.baseDir)
+                           : loader.LoadASCIIFromString(&model, &err, &warn, loadJson.data(),
+                                                        static_cast<unsigned int>(loadJson.size()), access.baseDir);
     if (!imageLog.overBudget.empty()) throw Error(path + ": " + imageLog.overBudget);
     if (!ok) throw Error(path + ": " + (err.empty() ? std::string("tinygltf could not load the file") : oneLine(err)));
     if (!warn.empty()) doc_->warnings.push_back(path + ": " + oneLine(warn));
+    // Compressed geometry, once per file: the Draco primitives' indices back, meshopt views decoded.
+    restoreDracoIndices(model, facts);
+    decodeMeshoptViews(path, model, facts.fallbackBuffers, options);
   } catch (const Error&) {
     throw;
+  } catch (const std::bad_alloc&) {
+    throw Error(path + ": out of memory while decoding the file");
   } catch (const std::exception& e) {
     throw Error(path + ": " + oneLine(e.what()));
   }

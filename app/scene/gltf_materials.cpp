@@ -1,20 +1,18 @@
 // gltf_materials.cpp — glTF materials after the contract in docs/materials.md, and their textures:
-// images decoded by stb_image (tinygltf's image callback), samplers, the default material.
+// images decoded by stb_image or libwebp (tinygltf's image callback), samplers, the default material.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
+
+#include <webp/decode.h>
 
 #include "scene/gltf_internal.h"
 
 namespace caustica::gltf {
 namespace {
-
-const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
-  const auto it = map.find(name);
-  return it == map.end() || !it->second.IsObject() ? nullptr : &it->second;
-}
 
 double extNumber(const tinygltf::Value* ext, const char* key, double fallback) {
   if (!ext || !ext->Has(key) || !ext->Get(key).IsNumber()) return fallback;
@@ -49,13 +47,27 @@ void wrapMode(int mode, bool& repeat, bool& mirror) {
 
 }  // namespace
 
+namespace {
+// A WebP file: "RIFF", 4 size bytes, "WEBP".
+bool isWebp(const unsigned char* bytes, int size) {
+  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
+}
+}  // namespace
+
 bool decodeImage(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
                  const unsigned char* bytes, int size, void* user) {
   auto* log = static_cast<ImageLog*>(user);
   int w = 0, h = 0, channels = 0;
-  if (!bytes || size <= 0 || !stbi_info_from_memory(bytes, size, &w, &h, &channels)) {
+  const bool webp = bytes && size > 0 && isWebp(bytes, size);
+  if (webp) {
+    if (!WebPGetInfo(bytes, std::size_t(size), &w, &h)) {
+      log->failures[index] = "not a decodable WebP image (bad header, or an animated WebP)";
+      return true;
+    }
+  } else if (!bytes || size <= 0 || !stbi_info_from_memory(bytes, size, &w, &h, &channels)) {
     const char* reason = stbi_failure_reason();
-    log->failures[index] = std::string("not a decodable PNG/JPEG image (") + (reason ? reason : "unknown format") + ")";
+    log->failures[index] =
+        std::string("not a decodable PNG/JPEG/WebP image (") + (reason ? reason : "unknown format") + ")";
     return true;
   }
   if (w < 1 || h < 1 || w > kMaxTextureSide || h > kMaxTextureSide ||
@@ -72,9 +84,11 @@ bool decodeImage(tinygltf::Image* image, const int index, std::string*, std::str
                       ", more than the limit of " + mib(log->budget) + " (use --max-texture-mib to raise it)";
     return false;
   }
-  unsigned char* pixels = stbi_load_from_memory(bytes, size, &w, &h, &channels, 4);
+  // PNG and JPEG through stb_image, WebP (EXT_texture_webp) through libwebp; both to 8-bit RGBA.
+  unsigned char* pixels = webp ? WebPDecodeRGBA(bytes, std::size_t(size), &w, &h)
+                               : stbi_load_from_memory(bytes, size, &w, &h, &channels, 4);
   if (!pixels) {
-    const char* reason = stbi_failure_reason();
+    const char* reason = webp ? "libwebp could not decode it" : stbi_failure_reason();
     log->failures[index] = std::string("it could not be decoded (") + (reason ? reason : "unknown error") + ")";
     return true;
   }
@@ -84,7 +98,8 @@ bool decodeImage(tinygltf::Image* image, const int index, std::string*, std::str
   image->bits = 8;
   image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
   image->image.assign(pixels, pixels + std::size_t(w) * std::size_t(h) * 4);
-  stbi_image_free(pixels);
+  if (webp) WebPFree(pixels);
+  else stbi_image_free(pixels);
   return true;
 }
 
@@ -121,13 +136,15 @@ Material SceneBuilder::convertMaterial(int index) {
     base.a = 1.0;
   } else if (m.alphaMode == "MASK") {
     if (!(m.alphaCutoff >= 0.0)) fail(at + ".alphaCutoff is " + num(m.alphaCutoff) + "; it must be >= 0");
-    if (out.baseColorTexture >= 0) out.alphaCutoff = float(m.alphaCutoff);
-    else base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
+    out.alphaCutoff = float(m.alphaCutoff);
+    out.maskAlpha = float(base.a);
+    if (out.baseColorTexture < 0) base.a = base.a >= m.alphaCutoff ? 1.0 : 0.0;
   } else if (m.alphaMode != "BLEND") {
     fail(at + ".alphaMode is \"" + oneLine(m.alphaMode) + "\"; it must be OPAQUE, BLEND or MASK");
   }
   out.baseColor = glm::vec4(base);
-  out.alphaFromTexture = out.baseColorTexture >= 0 && (m.alphaMode == "BLEND" || m.alphaMode == "MASK");
+  out.alphaFromVertices = m.alphaMode == "BLEND" || m.alphaMode == "MASK";
+  out.alphaFromTexture = out.baseColorTexture >= 0 && out.alphaFromVertices;
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength = radiance (linear).
   glm::dvec3 emissive(0.0);
@@ -239,7 +256,7 @@ Material SceneBuilder::convertMaterial(int index) {
     else out.dispersion = float(dispersion);
   }
   if (extension(m.extensions, "KHR_materials_unlit")) makeUnlit(out);
-  if (!ignored.empty()) warn(at + " '" + oneLine(out.name) + "': ignoring unsupported " + ignored);
+  if (!ignored.empty()) notRendered(at + " '" + oneLine(out.name) + "': " + ignored);
   // Triangles carry one UV set, so a material's textures must agree on theirs (TEXCOORD_0 or _1).
   if (materialTexCoords_.size() == 1 && (*materialTexCoords_.begin() == 0 || *materialTexCoords_.begin() == 1)) {
     out.texCoord = *materialTexCoords_.begin();
@@ -304,17 +321,25 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
   const tinygltf::Texture& tex = model_.textures[std::size_t(info.index)];
   const std::string tat = "textures[" + str(std::uint64_t(info.index)) + "]";
   int result = -1;
-  if (tex.source < 0) {
-    warn(tat + " has no PNG/JPEG source image; ignored");
+  // EXT_texture_webp names the WebP image, which replaces the (PNG/JPEG fallback) source.
+  int source = tex.source;
+  std::string sourceAt = tat + ".source";
+  if (const tinygltf::Value* webp = extension(tex.extensions, "EXT_texture_webp")) {
+    if (webp->Has("source") && webp->Get("source").IsInt()) {
+      source = webp->Get("source").GetNumberAsInt();
+      sourceAt = tat + ".extensions.EXT_texture_webp.source";
+    }
+  }
+  if (source < 0) {
+    warn(tat + " has no source image; ignored");
   } else {
-    if (std::size_t(tex.source) >= model_.images.size())
-      fail(tat + ".source is " + str(std::uint64_t(tex.source)) + ", but the file has " + str(model_.images.size()) +
-           " images");
-    const tinygltf::Image& img = model_.images[std::size_t(tex.source)];
-    const std::string iat = "images[" + str(std::uint64_t(tex.source)) + "]" +
+    if (std::size_t(source) >= model_.images.size())
+      fail(sourceAt + " is " + str(std::uint64_t(source)) + ", but the file has " + str(model_.images.size()) + " images");
+    const tinygltf::Image& img = model_.images[std::size_t(source)];
+    const std::string iat = "images[" + str(std::uint64_t(source)) + "]" +
                             (img.uri.empty() ? std::string() : " '" + oneLine(img.uri) + "'");
     if (img.image.empty()) {
-      const auto reason = images_.failures.find(tex.source);
+      const auto reason = images_.failures.find(source);
       fail(iat + " could not be loaded: " +
            (reason != images_.failures.end() ? reason->second : std::string("file not found or unreadable")));
     }

@@ -20,7 +20,8 @@
 namespace caustica::gltf {
 
 void SceneBuilder::build() {
-  warnUnsupportedExtensions();
+  quantized_ = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), "KHR_mesh_quantization") !=
+               model_.extensionsUsed.end();
   for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
   keepUv_ = keepsTexcoords(scene_.materials);  // the default material added later reads none
   readAnimations();  // gltf_animation.cpp: the pose's node TRS and morph weights
@@ -40,6 +41,7 @@ void SceneBuilder::build() {
   if (degenerate_ > 0) warn("skipped " + str(degenerate_) + " degenerate (zero-area) triangle(s)");
   if (badNormals_ > 0)
     warn(str(badNormals_) + " triangle(s) had zero or non-finite vertex normals; flat normals used for them");
+  warnNotRendered();
   if (scene_.triangles.empty()) {
     std::string why = firstSkip_;
     if (why.empty() && degenerate_ > 0) why = "all " + str(degenerate_) + " triangles have zero area";
@@ -60,12 +62,6 @@ void SceneBuilder::build() {
   }
 }
 
-void SceneBuilder::warnUnsupportedExtensions() {
-  std::string list;
-  for (const std::string& ext : model_.extensionsUsed)
-    if (!isSupportedExtension(ext)) list += (list.empty() ? "" : ", ") + oneLine(ext);
-  if (!list.empty()) warn("ignoring unsupported extension(s): " + list);
-}
 
 namespace {
 // Triangles a primitive declares (accessor counts; 0 for other modes or bad indices, reported later).
@@ -363,13 +359,14 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
          " cameras");
   const tinygltf::Camera& cam = model_.cameras[std::size_t(index)];
   const std::string cat = "cameras[" + str(std::uint64_t(index)) + "]";
-  if (cam.type != "perspective") {
-    warn(cat + " is " + oneLine(cam.type) + "; only perspective cameras are used");
-    return;
-  }
-  const double yfov = cam.perspective.yfov;
-  if (!(yfov > 0.0 && yfov < kPiD))
+  const bool orthographic = cam.type == "orthographic";
+  const double yfov = orthographic ? 0.7 : cam.perspective.yfov;
+  if (!orthographic && !(yfov > 0.0 && yfov < kPiD))
     fail(cat + ".perspective.yfov is " + num(yfov) + "; it must be an angle in radians between 0 and pi");
+  // glTF's xmag and ymag are half the view's width and height (checkJson: finite, not 0; their sign
+  // carries no meaning here).
+  const double ymag = orthographic ? std::abs(cam.orthographic.ymag) : 0.0;
+  const double xmag = orthographic ? std::abs(cam.orthographic.xmag) : 0.0;
   const glm::dmat3 m3(world);
   const glm::dvec3 position = glm::dvec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0)) - origin_;
   const glm::dvec3 f = m3 * glm::dvec3(0.0, 0.0, -1.0);
@@ -389,6 +386,13 @@ void SceneBuilder::addCamera(int index, const glm::dmat4& world, const tinygltf:
   out.up = glm::vec3(upOrtho / ul);
   out.yfov = float(yfov);
   out.aspect = cam.perspective.aspectRatio > 0.0 ? float(cam.perspective.aspectRatio) : 0.0f;
+  if (orthographic) {
+    // The node's scale does not scale the view (glTF 3.10.3: camera transforms exclude scale).
+    out.orthoHeight = float(ymag);
+    out.aspect = float(xmag / ymag);
+    if (!std::isfinite(out.orthoHeight) || !std::isfinite(out.aspect) || !(out.orthoHeight > 0.0f))
+      fail(cat + ".orthographic: xmag and ymag must be finite and not 0");
+  }
   scene_.cameras.push_back(out);
 }
 
@@ -438,19 +442,32 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     skip(at + ": mode " + std::to_string(prim.mode) + " is not a valid primitive mode; primitive skipped");
     return;
   }
-  const auto posIt = prim.attributes.find("POSITION");
-  if (posIt == prim.attributes.end()) {
+  if (prim.attributes.find("POSITION") == prim.attributes.end()) {
     skip(at + " has no POSITION attribute; primitive skipped");
     return;
   }
-  std::vector<double> positions =
-      readAccessor(posIt->second, TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, at + " POSITION");
+  // KHR_draco_mesh_compression: the attributes it lists and the indices come from the Draco data;
+  // readAttribute takes them from there while draco_ is set.
+  DracoPrimitive draco;
+  const bool compressed = prim.extensions.count("KHR_draco_mesh_compression") > 0;
+  if (compressed) {
+    if (prim.mode != TINYGLTF_MODE_TRIANGLES)
+      fail(at + ": a KHR_draco_mesh_compression primitive must have mode TRIANGLES (4), not " + std::to_string(prim.mode));
+    draco = decodeDraco(prim, at);
+  }
+  draco_ = compressed ? &draco : nullptr;
+  struct ResetDraco {
+    const DracoPrimitive*& p;
+    ~ResetDraco() { p = nullptr; }
+  } resetDraco{draco_};
+  std::vector<double> positions = readAttribute(prim, "POSITION", TINYGLTF_TYPE_VEC3,
+                                                attributeFormats(VertexAttribute::Position, quantized_), kAnyCount, at);
   const std::size_t vertexCount = positions.size() / 3;
   for (std::size_t i = 0; i < positions.size(); ++i)
     if (!std::isfinite(positions[i]))
       fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
-  std::vector<double> normals = readAttribute(
-      prim, "NORMAL", TINYGLTF_TYPE_VEC3, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, vertexCount, at);
+  std::vector<double> normals =
+      readAttribute(prim, "NORMAL", TINYGLTF_TYPE_VEC3, attributeFormats(VertexAttribute::Normal, quantized_), vertexCount, at);
   // The pose (gltf_animation.cpp): morph targets blended, then skinned meshes placed by their joints
   // (world space; xf is then the identity). mirrored[v]: vertex v's skin matrix mirrors.
   std::vector<bool> mirrored;
@@ -471,13 +488,15 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
   }
 
   std::vector<std::uint32_t> indices;
-  if (prim.indices >= 0) {
-    const std::vector<double> raw =
-        readAccessor(prim.indices, TINYGLTF_TYPE_SCALAR,
-                     {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false},
-                      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false},
-                      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false}},
-                     at + " indices");
+  if (compressed || prim.indices >= 0) {
+    std::vector<double> raw;
+    if (compressed) {
+      if (prim.indices >= 0)  // the accessor still declares the index type
+        checkedAccessor(prim.indices, TINYGLTF_TYPE_SCALAR, kIndexFormats, at + " indices");
+      raw = std::move(draco.indices);
+    } else {
+      raw = readAccessor(prim.indices, TINYGLTF_TYPE_SCALAR, kIndexFormats, at + " indices");
+    }
     indices.reserve(raw.size());
     for (std::size_t i = 0; i < raw.size(); ++i) {
       if (raw[i] >= double(vertexCount))
@@ -505,13 +524,43 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
   if (scene_.materials[material].texCoord == 1 && uvName != "TEXCOORD_1")
     warn(at + ": its material's textures read TEXCOORD_1, which the primitive lacks; TEXCOORD_0 is used");
   const std::vector<double> uvs =
-      readAttribute(prim, uvName.c_str(), TINYGLTF_TYPE_VEC2,
-                    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false},
-                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
-                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
-                    vertexCount, at);
+      readAttribute(prim, uvName.c_str(), TINYGLTF_TYPE_VEC2, attributeFormats(VertexAttribute::Texcoord, quantized_), vertexCount, at);
   for (std::size_t i = 0; i < uvs.size(); ++i)
     if (!std::isfinite(uvs[i])) fail(at + ": " + uvName + " of vertex " + str(i / 2) + " is not finite");
+  // COLOR_0 (VEC3 or VEC4: float, normalized unsigned byte or short) multiplies the base colour and,
+  // its alpha, the opacity; kept per triangle only once some primitive has it.
+  std::vector<double> colors;
+  int colorComponents = 0;
+  if (const auto c = prim.attributes.find("COLOR_0"); c != prim.attributes.end()) {
+    const int type = c->second >= 0 && std::size_t(c->second) < model_.accessors.size() &&
+                             model_.accessors[std::size_t(c->second)].type == TINYGLTF_TYPE_VEC3
+                         ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4;
+    colorComponents = type == TINYGLTF_TYPE_VEC3 ? 3 : 4;
+    colors = readAttribute(prim, "COLOR_0", type, attributeFormats(VertexAttribute::Color, quantized_), vertexCount, at);
+    for (std::size_t i = 0; i < colors.size(); ++i)
+      if (!std::isfinite(colors[i])) fail(at + ": COLOR_0 of vertex " + str(i / std::size_t(colorComponents)) + " is not finite");
+    if (!keepColors_) scene_.colors.resize(scene_.triangles.size());  // white before the first
+    keepColors_ = true;
+  }
+  // TANGENT (VEC4: xyz and the bitangent's sign) orients the material's normal map, when it has one.
+  std::vector<double> tangents;
+  // A skinned or morphed pose moves the surface under the file's tangents, which are not posed: the
+  // normal map then takes the posed triangle's dp/du.
+  const bool posedShape = pose.posed() && (pose.skin >= 0 || !prim.targets.empty());
+  if (scene_.materials[material].normalTexture >= 0 && prim.attributes.count("TANGENT") && !posedShape) {
+    tangents = readAttribute(prim, "TANGENT", TINYGLTF_TYPE_VEC4, attributeFormats(VertexAttribute::Tangent, quantized_),
+                             vertexCount, at);
+    if (!keepTangents_) scene_.tangents.resize(scene_.triangles.size());  // none before the first
+    keepTangents_ = true;
+  }
+  const auto tangentAt = [&](std::size_t i) -> glm::vec4 {  // world space; 0 where unusable
+    const glm::dvec3 t = glm::dmat3(xf.world) * glm::dvec3(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
+    const double len = glm::length(t);
+    if (!(len > 1e-20) || !std::isfinite(len) || !std::isfinite(tangents[4 * i + 3])) return glm::vec4(0.0f);
+    // A mirroring transform turns cross(normal, tangent) around: the sign follows the determinant.
+    const float w = (tangents[4 * i + 3] < 0.0) != xf.flip ? -1.0f : 1.0f;
+    return glm::vec4(glm::vec3(t / len), w);
+  };
 
   // Corner triples in glTF's counter-clockwise order for each mode (glTF 3.7.2.1).
   const std::size_t n = indices.size();
@@ -542,6 +591,8 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     if (xf.flip != (!mirrored.empty() && mirrored[v[0]])) std::swap(v[1], v[2]);
     Triangle tri;
     TriangleUv uv;
+    TriangleColors color;
+    TriangleTangents tangent;
     tri.material = material;
     bool finite = true;
     for (int k = 0; k < 3; ++k) {
@@ -550,6 +601,12 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       tri.p[k] = glm::vec3(glm::dvec3(p) - origin_);
       finite = finite && std::isfinite(tri.p[k].x) && std::isfinite(tri.p[k].y) && std::isfinite(tri.p[k].z);
       uv.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
+      if (!colors.empty()) {
+        const std::size_t cn = std::size_t(colorComponents);
+        color.color[k] = glm::vec4(float(colors[cn * i]), float(colors[cn * i + 1]), float(colors[cn * i + 2]),
+                                   cn == 4 ? float(colors[cn * i + 3]) : 1.0f);
+      }
+      if (!tangents.empty()) tangent.tangent[k] = tangentAt(i);
     }
     if (!finite) fail(at + ": a vertex position overflows a float after the node transform");
     const glm::vec3 cross = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
@@ -572,6 +629,8 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     }
     scene_.triangles.push_back(tri);
     if (keepUv_) scene_.texcoords.push_back(uv);
+    if (keepColors_) scene_.colors.push_back(color);
+    if (keepTangents_) scene_.tangents.push_back(tangent);
   }
 }
 

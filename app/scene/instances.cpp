@@ -11,12 +11,19 @@
 namespace caustica {
 
 namespace {
+// Where flattenInstance appends the per-triangle arrays a scene keeps besides its triangles.
+struct TriangleExtras {
+  std::vector<TriangleUv>* uv = nullptr;
+  std::vector<TriangleColors>* colors = nullptr;
+  std::vector<TriangleTangents>* tangents = nullptr;
+};
+
 // Appends instance `in`'s world-space triangles (zero-area ones dropped; with `materialWanted`, only
 // those of the wanted materials) to `out`, and to `source` (when given) the Scene::triangles index each
 // came from.
 void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangle>& out,
                      std::vector<std::uint32_t>* source, const std::vector<bool>* materialWanted = nullptr,
-                     std::vector<TriangleUv>* outUv = nullptr) {
+                     TriangleExtras extras = {}) {
   const MeshRange& m = scene.meshes[in.mesh];
   const glm::dmat3 m3(in.world);
   const glm::dmat3 normal = glm::transpose(glm::inverse(m3));
@@ -26,6 +33,8 @@ void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangl
     if (materialWanted && (src.material >= materialWanted->size() || !(*materialWanted)[src.material])) continue;
     Triangle t;
     TriangleUv uv;
+    TriangleColors color;
+    TriangleTangents tangent;
     t.material = src.material;
     glm::vec3 n[3];
     for (int k = 0; k < 3; ++k) {
@@ -36,6 +45,13 @@ void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangl
       const double len = glm::length(nw);
       n[k] = len > 0.0 && std::isfinite(len) ? glm::vec3(nw / len) : glm::vec3(0.0f);
       uv.uv[k] = triangleUv(scene, i, s);
+      color.color[k] = triangleColor(scene, i, s);
+      // Tangents turn with the instance (not its inverse transpose); a mirroring one flips the sign.
+      const glm::vec4 ts = triangleTangent(scene, i, s);
+      const glm::dvec3 tw = m3 * glm::dvec3(glm::vec3(ts));
+      const double tl = glm::length(tw);
+      if (ts.w != 0.0f && tl > 0.0 && std::isfinite(tl))
+        tangent.tangent[k] = glm::vec4(glm::vec3(tw / tl), flip ? -ts.w : ts.w);
     }
     const glm::vec3 cross = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
     const float area2 = glm::length(cross);
@@ -43,7 +59,9 @@ void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangl
     if (n[0] == glm::vec3(0.0f) || n[1] == glm::vec3(0.0f) || n[2] == glm::vec3(0.0f)) n[0] = n[1] = n[2] = cross / area2;
     for (int k = 0; k < 3; ++k) t.setNormal(k, n[k]);
     out.push_back(t);
-    if (outUv) outUv->push_back(uv);
+    if (extras.uv) extras.uv->push_back(uv);
+    if (extras.colors) extras.colors->push_back(color);
+    if (extras.tangents) extras.tangents->push_back(tangent);
     if (source) source->push_back(i);
   }
 }
@@ -52,14 +70,20 @@ void flattenInstance(const Scene& scene, const Instance& in, std::vector<Triangl
 void flattenInstances(Scene& scene) {
   if (scene.instances.empty()) return;
   std::vector<Triangle> out;
-  std::vector<TriangleUv> outUv;  // only where the scene keeps texture coordinates
-  const bool uv = !scene.texcoords.empty();
-  const std::size_t total = instancedTriangleCount(scene);
-  out.reserve(total);
-  if (uv) outUv.reserve(total);
-  for (const Instance& in : scene.instances) flattenInstance(scene, in, out, nullptr, nullptr, uv ? &outUv : nullptr);
+  // Only the arrays the scene keeps (texture coordinates, vertex colours, tangents).
+  std::vector<TriangleUv> outUv;
+  std::vector<TriangleColors> outColors;
+  std::vector<TriangleTangents> outTangents;
+  TriangleExtras extras;
+  if (!scene.texcoords.empty()) extras.uv = &outUv;
+  if (!scene.colors.empty()) extras.colors = &outColors;
+  if (!scene.tangents.empty()) extras.tangents = &outTangents;
+  out.reserve(instancedTriangleCount(scene));
+  for (const Instance& in : scene.instances) flattenInstance(scene, in, out, nullptr, nullptr, extras);
   scene.triangles = std::move(out);
   scene.texcoords = std::move(outUv);
+  scene.colors = std::move(outColors);
+  scene.tangents = std::move(outTangents);
   scene.meshes.clear();
   scene.instances.clear();
 }

@@ -147,6 +147,8 @@ void applyLightRadius(Scene& scene, float radius) {
       t.material = material;
       scene.triangles.push_back(t);
       if (!scene.texcoords.empty()) scene.texcoords.emplace_back();  // (0, 0): the sphere reads no texture
+      if (!scene.colors.empty()) scene.colors.emplace_back();        // white
+      if (!scene.tangents.empty()) scene.tangents.emplace_back();    // none
     }
   }
   scene.punctualLights = std::move(kept);

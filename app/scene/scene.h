@@ -50,7 +50,11 @@ struct Material {
   float specularF90 = 0.0f;
   int texCoord = 0;                   // the UV set (TEXCOORD_0 or TEXCOORD_1) every texture of the material reads
   bool alphaFromTexture = false;      // BLEND or MASK with a base-colour texture: its alpha multiplies baseColor.a
+  bool alphaFromVertices = false;     // BLEND or MASK: COLOR_0's alpha multiplies baseColor.a (vertex colours)
   float alphaCutoff = -1.0f;          // alphaMode MASK: opaque where alpha >= cutoff, else absent; < 0: not MASK
+  // MASK: baseColorFactor's alpha. Without a texture baseColor.a holds it already thresholded (0 or 1);
+  // with vertex colours the threshold is taken per hit, of maskAlpha x COLOR_0's alpha.
+  float maskAlpha = 1.0f;
   float transmission = 0.0f;          // KHR_materials_transmission: dielectric weight in [0,1]
   float ior = 1.5f;                   // KHR_materials_ior, at 587.6 nm
   float dispersion = 0.0f;            // KHR_materials_dispersion (20 / Abbe number), 0 = none
@@ -121,6 +125,19 @@ struct TriangleUv {
   glm::vec2 uv[3]{glm::vec2(0.0f), glm::vec2(0.0f), glm::vec2(0.0f)};
 };
 
+// A triangle's vertex colours: COLOR_0 (linear RGB, and alpha), which multiplies its material's base
+// colour and opacity (glTF 3.7.2.1). White where a primitive has none.
+struct TriangleColors {
+  glm::vec4 color[3]{glm::vec4(1.0f), glm::vec4(1.0f), glm::vec4(1.0f)};
+};
+
+// A triangle's vertex tangents (the file's TANGENT, world space): xyz unit, w the bitangent's sign
+// (bitangent = cross(normal, xyz) * w); (0, 0, 0, 0) where the primitive has none (the normal map then
+// takes the triangle's dp/du).
+struct TriangleTangents {
+  glm::vec4 tangent[3]{glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f)};
+};
+
 // A triangle with positions only: no normals, texture coordinates zero (OBJ meshes, tests, benchmarks).
 inline Triangle makeTriangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, std::uint32_t material = 0) {
   Triangle t{};
@@ -131,14 +148,18 @@ inline Triangle makeTriangle(const glm::vec3& a, const glm::vec3& b, const glm::
   return t;
 }
 
-// Pinhole camera. Looks down -Z of its node in glTF; here stored in world space.
+// Pinhole or orthographic camera. Looks down -Z of its node in glTF; here stored in world space.
 struct Camera {
   std::string name;
   glm::vec3 position{0.0f};
   glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit
   glm::vec3 up{0.0f, 1.0f, 0.0f};        // unit, orthogonal to forward
-  float yfov = 0.7f;                      // vertical field of view, radians
+  float yfov = 0.7f;                      // vertical field of view, radians (pinhole)
   float aspect = 0.0f;                    // width / height from the file; 0 = take it from the image
+  // Orthographic (glTF's ymag): half the image's height in scene units; rays leave the image plane
+  // through `position` along `forward`, the width following the image's aspect. 0: a pinhole camera.
+  float orthoHeight = 0.0f;
+  bool orthographic() const { return orthoHeight > 0.0f; }
 };
 
 struct Bounds {
@@ -170,6 +191,12 @@ struct Scene {
   // Texture coordinates of triangles[i] at texcoords[i]; empty when no material reads a texture (24 B per
   // triangle saved), else exactly as long as `triangles`. Read them with triangleUv().
   std::vector<TriangleUv> texcoords;
+  // Vertex colours of triangles[i] at colors[i]: empty unless some primitive has COLOR_0 (48 B per
+  // triangle), else exactly as long as `triangles`. Read them with triangleColor().
+  std::vector<TriangleColors> colors;
+  // Vertex tangents of triangles[i] at tangents[i]: empty unless some normal-mapped primitive has
+  // TANGENT, else exactly as long as `triangles`. Read them with triangleTangent().
+  std::vector<TriangleTangents> tangents;
   // Empty unless loaded with LoadOptions::keepInstances: then every triangle belongs to exactly one
   // mesh and the scene is the union of its instances (flattenInstances makes it world space).
   std::vector<MeshRange> meshes;
@@ -199,6 +226,14 @@ struct Scene {
 // Corner k's texture coordinates of triangle i; (0, 0) in a scene that keeps none.
 inline glm::vec2 triangleUv(const Scene& s, std::size_t i, int k) {
   return s.texcoords.empty() ? glm::vec2(0.0f) : s.texcoords[i].uv[k];
+}
+// Corner k's vertex colour (linear RGBA) of triangle i; white in a scene without vertex colours.
+inline glm::vec4 triangleColor(const Scene& s, std::size_t i, int k) {
+  return s.colors.empty() ? glm::vec4(1.0f) : s.colors[i].color[k];
+}
+// Corner k's tangent of triangle i (xyz, sign w); zero in a scene without tangents.
+inline glm::vec4 triangleTangent(const Scene& s, std::size_t i, int k) {
+  return s.tangents.empty() ? glm::vec4(0.0f) : s.tangents[i].tangent[k];
 }
 // Whether a scene with these materials keeps texture coordinates (Scene::texcoords).
 inline bool keepsTexcoords(const std::vector<Material>& materials) {

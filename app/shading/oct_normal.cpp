@@ -67,4 +67,16 @@ std::uint32_t octEncode(const glm::vec3& n) {
   return bits(bestX) | bits(bestY) << 16;
 }
 
+std::uint32_t tangentWord(const glm::vec4& t) {
+  if (t.w == 0.0f) return kOctNoNormal;
+  const std::uint32_t w = octEncode(glm::vec3(t));
+  if (w == kOctNoNormal) return kOctNoNormal;
+  return t.w < 0.0f ? w | 1u : w & ~1u;
+}
+
+glm::vec4 tangentFromWord(std::uint32_t w) {
+  if (w == kOctNoNormal) return glm::vec4(0.0f);
+  return glm::vec4(octDecode(w), (w & 1u) != 0u ? -1.0f : 1.0f);
+}
+
 }  // namespace caustica

@@ -18,4 +18,11 @@ std::uint32_t octEncode(const glm::vec3& n);
 // The unit normal of an encoded word; (0, 0, 0) for gpu::kOctZeroNormal.
 glm::vec3 octDecode(std::uint32_t w);
 
+// A tangent (xyz unit, w = +-1 the bitangent's sign) in one word: octEncode(xyz) with bit 0 (the low
+// bit of x's snorm, moving the direction by at most one grid step, 3e-5 rad) set where w < 0;
+// kOctNoNormal where w = 0 ("none"). tangentDecode in glsl/lib/oct_normal.glsl is the twin.
+std::uint32_t tangentWord(const glm::vec4& t);
+// The tangent (xyz unit, w = +-1) of a tangentWord; (0, 0, 0, 0) for kOctNoNormal.
+glm::vec4 tangentFromWord(std::uint32_t w);
+
 }  // namespace caustica

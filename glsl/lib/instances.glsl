@@ -58,6 +58,35 @@ void instanceUvs(uint tri, InstanceXform x, out vec2 t0, out vec2 t1, out vec2 t
   t2 = x.mirrored ? a : b;
 }
 
+// Vertex colours of stored triangle `tri` in the corner order of instanceTriangle.
+void instanceColors(uint tri, InstanceXform x, out vec4 c0, out vec4 c1, out vec4 c2) {
+  vec4 a, b;
+  triColors(tri, c0, a, b);
+  c1 = x.mirrored ? b : a;
+  c2 = x.mirrored ? a : b;
+}
+
+// A stored tangent to world space: turned by the 3x3 part (a direction along the surface, not a
+// normal), normalized; a mirroring instance flips the bitangent's sign, as flattenInstances does.
+vec4 instanceTangent(InstanceXform x, vec4 t) {
+  if (t.w == 0.0) return t;
+  vec3 w = vec3(dot(x.r0.xyz, t.xyz), dot(x.r1.xyz, t.xyz), dot(x.r2.xyz, t.xyz));
+  float len = length(w);
+  if (!(len > 0.0)) return vec4(0.0);
+  return vec4(w / len, x.mirrored ? -t.w : t.w);
+}
+
+// Vertex tangents of stored triangle `tri` in world space and the corner order of instanceTriangle.
+void instanceTangents(uint tri, InstanceXform x, out vec4 t0, out vec4 t1, out vec4 t2) {
+  vec4 a, b;
+  triTangents(tri, t0, a, b);
+  t0 = instanceTangent(x, t0);
+  a = instanceTangent(x, a);
+  b = instanceTangent(x, b);
+  t1 = x.mirrored ? b : a;
+  t2 = x.mirrored ? a : b;
+}
+
 // Everything a closest hit's shading reads, in world space: the triangle, its vertex normals (unit
 // or 0) and texcoords in instanceTriangle's corner order; hit.u, hit.v (object corners 1, 2) follow.
 void instanceHitTriangle(inout Hit hit, InstanceXform x, out TriGeom g, out vec3 n0, out vec3 n1, out vec3 n2,

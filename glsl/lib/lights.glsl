@@ -75,7 +75,17 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   // passThrough), so that both estimators weigh the same emission.
   ls.le = materialEmissionSeen(m, uv, dot(ls.n, normalize(p - ls.p)));
 #ifdef CAUSTICA_OPACITY
-  ls.le *= materialBaseColor(m, uv).a;
+  vec4 color = vec4(1.0);  // the vertex colour, whose alpha is part of the opacity (surface.glsl)
+#if defined(CAUSTICA_VERTEX_COLORS) && defined(CAUSTICA_TRISHADE_COLORS)
+  vec4 c0, c1, c2;
+#ifdef CAUSTICA_INSTANCED
+  instanceColors(tri, xf, c0, c1, c2);
+#else
+  triColors(tri, c0, c1, c2);
+#endif
+  color = (1.0 - b.x - b.y) * c0 + b.x * c1 + b.y * c2;
+#endif
+  ls.le *= materialBaseColor(m, uv, color).a;
 #endif
   ls.pdfArea = pmf / (0.5 * len);
   ls.twoSided = (m.tex.z & kMatDoubleSided) != 0u;

@@ -3,16 +3,28 @@
 // sheen layers' parameters (layers.glsl), lobe choice (metal weight m, glass (1-m)t, diffuse (1-m)(1-t);
 // each a delta lobe or a GGX lobe from microfacet.glsl) and the smooth dielectric.
 
-// Linear base colour (rgb) and opacity (a) at uv.
-vec4 materialBaseColor(Material m, vec2 uv) {
+// Linear base colour (rgb) and opacity (a) at uv, for a hit whose vertex colour (COLOR_0) is
+// vertexColor: factor x texture x vertex colour (glTF 3.9.2); alpha likewise in BLEND and MASK only.
+vec4 materialBaseColor(Material m, vec2 uv, vec4 vertexColor) {
   vec4 c = m.baseColor;
+#ifdef CAUSTICA_VERTEX_COLORS
+  c.rgb *= vertexColor.rgb;
+  if ((m.tex.z & kMatVertexAlpha) != 0u) c.a *= vertexColor.a;
+#endif
 #ifdef CAUSTICA_TEXTURES
   if (m.tex.x != kInvalidIndex) {
     vec4 t = sampleTexture(m.tex.x, uv);
     c.rgb *= t.rgb;
     if ((m.tex.z & kMatAlphaTexture) != 0u) c.a *= t.a;  // BLEND and MASK only; OPAQUE ignores alpha
+#ifndef CAUSTICA_VERTEX_COLORS
     if ((m.tex.z & kMatAlphaMask) != 0u) c.a = c.a >= uintBitsToFloat(m.tex2.w) ? 1.0 : 0.0;
+#endif
   }
+#endif
+#ifdef CAUSTICA_VERTEX_COLORS
+  // MASK with a texture or vertex alpha: the threshold of the product (without either, the host
+  // thresholded the factor).
+  if ((m.tex.z & kMatAlphaMask) != 0u) c.a = c.a >= uintBitsToFloat(m.tex2.w) ? 1.0 : 0.0;
 #endif
   return c;
 }
@@ -78,26 +90,46 @@ vec4 materialSheen(Material m, vec2 uv) {
 }
 #endif
 
-// The shading normal after normal map `tex` (tangent space, glTF: +x along +u, +y towards -v, i.e. up
-// in the image; its x and y times `scale`). n: interpolated unit normal on the front side; p0..p2 and
-// uv0..uv2 the triangle's corners: the tangent is the triangle's dp/du made orthogonal to n (one tangent
-// per triangle; the file's TANGENT attribute is not read). Returns n where the map or the frame is unusable.
-vec3 applyNormalMapTexture(uint tex, float scale, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1,
-                           vec2 uv2) {
 #ifdef CAUSTICA_TEXTURES
-  if (tex == kInvalidIndex) return n;
+// The triangle's tangent frame: t its dp/du made orthogonal to n, b = cross(n, t) turned towards -v;
+// false where the texcoords or dp/du are degenerate.
+bool tangentFromTriangle(vec3 n, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2, out vec3 t, out vec3 b) {
   vec3 dp1 = p1 - p0, dp2 = p2 - p0;
   vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
   float det = d1.x * d2.y - d1.y * d2.x;
-  if (!(abs(det) > 0.0)) return n;
+  if (!(abs(det) > 0.0)) return false;
   vec3 dpdu = (dp1 * d2.y - dp2 * d1.y) / det;
   vec3 dpdv = (dp2 * d1.x - dp1 * d2.x) / det;
-  vec3 t = dpdu - n * dot(n, dpdu);
+  t = dpdu - n * dot(n, dpdu);
   float tLen = length(t);
-  if (!(tLen > 0.0)) return n;
+  if (!(tLen > 0.0)) return false;
   t /= tLen;
-  vec3 b = cross(n, t);
+  b = cross(n, t);
   if (dot(b, dpdv) > 0.0) b = -b;  // bitangent points towards -v (up in the image), mirrored maps included
+  return true;
+}
+#endif
+
+// The shading normal after normal map `tex` (tangent space, glTF: +x along the tangent, +y along the
+// bitangent; its x and y times `scale`). n: interpolated unit normal on the front side; tangent: the
+// file's TANGENT interpolated at the hit (xyz; w the bitangent's sign, glTF: bitangent = cross(n,
+// tangent) w), or w = 0 where the mesh has none: then the tangent is the triangle's dp/du (from p0..p2
+// and uv0..uv2) and the bitangent points towards -v (up in the image), the same frame for an unmirrored
+// map. Either tangent is made orthogonal to n. Returns n where the map or the frame is unusable.
+vec3 applyNormalMapTexture(uint tex, float scale, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1,
+                           vec2 uv2, vec4 tangent) {
+#ifdef CAUSTICA_TEXTURES
+  if (tex == kInvalidIndex) return n;
+  vec3 t, b;
+  if (tangent.w != 0.0) {
+    t = tangent.xyz - n * dot(n, tangent.xyz);
+    float len = length(t);
+    if (!(len > 0.0)) return n;
+    t /= len;
+    b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
+  } else if (!tangentFromTriangle(n, p0, p1, p2, uv0, uv1, uv2, t, b)) {
+    return n;
+  }
   vec3 c = sampleDataTexture(tex, uv).xyz * 2.0 - 1.0;
   c.xy *= scale;
   vec3 mapped = c.x * t + c.y * b + c.z * n;
@@ -109,8 +141,9 @@ vec3 applyNormalMapTexture(uint tex, float scale, vec3 n, vec2 uv, vec3 p0, vec3
 }
 
 // The material's normal map (normalTexture) applied to n (applyNormalMapTexture).
-vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2) {
-  return applyNormalMapTexture(m.tex2.y, uintBitsToFloat(m.tex2.z), n, uv, p0, p1, p2, uv0, uv1, uv2);
+vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2,
+                    vec4 tangent) {
+  return applyNormalMapTexture(m.tex2.y, uintBitsToFloat(m.tex2.z), n, uv, p0, p1, p2, uv0, uv1, uv2, tangent);
 }
 
 // Emitted radiance at uv (front face only unless double-sided; the caller checks the side).

@@ -11,3 +11,10 @@ vec3 octDecode(uint w) {
   n.y += n.y >= 0.0 ? -t : t;
   return normalize(n);
 }
+
+// The tangent of a TriShade tangent word (oct_normal.h's tangentWord): xyz unit, w the bitangent's
+// sign (bit 0 set: -1); vec4(0) for kOctZeroNormal (none).
+vec4 tangentDecode(uint w) {
+  if (w == kOctZeroNormal) return vec4(0.0);
+  return vec4(octDecode(w), (w & 1u) != 0u ? -1.0 : 1.0);
+}

@@ -32,8 +32,7 @@ struct PathState {
 PathState startPath(uvec2 pixel, uint sampleIndex) {
   PathState s;
   s.rng = rngSeed(pixel.y * frame.frame.x + pixel.x, sampleIndex, frame.frame.w);
-  s.org = frame.camPos.xyz;
-  s.dir = eyeRayDirection(pixel, rand2(s.rng));
+  eyeRay(pixel, rand2(s.rng), s.org, s.dir);
   s.beta = vec3(1.0);
   s.etaScale = 1.0;
   s.radiance = vec3(0.0);

@@ -13,6 +13,7 @@ struct Surface {
   vec3 nc;       // unit normal of the clear coat on that side: interpolated, with the coat's own normal map
 #endif
   vec2 uv;       // texcoords
+  vec4 color;    // vertex colour (COLOR_0, linear RGBA; white without CAUSTICA_VERTEX_COLORS)
   Material m;
   float t;       // distance along the (unit) ray
   uint tri;      // the hit's triangle (TriGeom order; instanced: the stored object-space one)
@@ -60,17 +61,43 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : sf.ngFront;
   if (dot(ns, sf.ngFront) < 0.0) ns = -ns;
   sf.uv = b0 * st0 + hit.u * st1 + hit.v * st2;
+  sf.color = vec4(1.0);  // exactly white where the scene has no colours (also under --all-features)
+#if defined(CAUSTICA_VERTEX_COLORS) && defined(CAUSTICA_TRISHADE_COLORS)
+  vec4 sc0, sc1, sc2;
+#ifdef CAUSTICA_INSTANCED
+  instanceColors(hit.tri, xf, sc0, sc1, sc2);
+#else
+  triColors(hit.tri, sc0, sc1, sc2);
+#endif
+  sf.color = b0 * sc0 + hit.u * sc1 + hit.v * sc2;
+#endif
   sf.m = materialAt(floatBitsToUint(g.v0.w));
+#ifdef CAUSTICA_TEXTURES
+  vec4 tangent = vec4(0.0);  // none: a normal map takes the triangle's dp/du
+#ifdef CAUSTICA_TRISHADE_TANGENTS
+  if (normalMapped) {
+    vec4 tt0, tt1, tt2;
+#ifdef CAUSTICA_INSTANCED
+    instanceTangents(hit.tri, xf, tt0, tt1, tt2);
+#else
+    triTangents(hit.tri, tt0, tt1, tt2);
+#endif
+    // The file's TANGENT where every corner has one (w: the first corner's sign).
+    if (tt0.w != 0.0 && tt1.w != 0.0 && tt2.w != 0.0) tangent = vec4(b0 * tt0.xyz + hit.u * tt1.xyz + hit.v * tt2.xyz, tt0.w);
+  }
+#endif
+#endif
 #ifdef CAUSTICA_CLEARCOAT
   vec3 nc = ns;  // KHR_materials_clearcoat: the base's normal map does not apply to the coat
 #ifdef CAUSTICA_TEXTURES
   if (normalMapped)
-    nc = applyNormalMapTexture(sf.m.tex3.z, sf.m.coat.z, nc, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
+    nc = applyNormalMapTexture(sf.m.tex3.z, sf.m.coat.z, nc, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2,
+                               tangent);
 #endif
   sf.nc = sf.front ? nc : -nc;
 #endif
 #ifdef CAUSTICA_TEXTURES
-  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2);
+  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2, tangent);
 #endif
   sf.ns = sf.front ? ns : -ns;
   return true;

@@ -8,6 +8,7 @@ in vec3 vPosition;
 in vec3 vNormal;
 in vec2 vUv;
 in vec3 vGeomNormal;
+in vec4 vColor;
 
 layout(location = 2) uniform vec3 eye;          // world-space eye (mirrored for a mirror pass)
 layout(location = 3) uniform vec4 baseColor;    // rgb: linear base colour; a: opacity
@@ -16,6 +17,8 @@ layout(location = 5) uniform vec4 params;       // x: metallic, y: roughness, z:
 layout(location = 6) uniform int hasTexture;    // 1: base colour texture on unit 0
 layout(location = 7) uniform int planarMirror;  // 1: this surface's reflection is drawn by a mirror pass
 layout(location = 8) uniform float shadowTexels; // side of a shadow cube face in texels
+layout(location = 9) uniform int vertexAlpha;   // 1: the vertex colour's alpha multiplies the opacity (BLEND, MASK)
+layout(location = 10) uniform int vertexColors; // 1: the scene has vertex colours (else vColor, interpolated white, is not read)
 
 layout(binding = 0) uniform sampler2D baseTexture;          // sRGB texture: sampled as linear
 layout(binding = 1) uniform samplerCubeArray shadowMaps;    // layer = light index; distance / far
@@ -44,6 +47,10 @@ void main() {
   if (!front) ns = -ns;
 
   vec4 base = baseColor;
+  if (vertexColors != 0) {  // COLOR_0
+    base.rgb *= vColor.rgb;
+    if (vertexAlpha != 0) base.a *= vColor.a;
+  }
   if (hasTexture != 0) base.rgb *= texture(baseTexture, vUv).rgb;
   float metal = params.x, trans = params.z;
   float diffuseWeight = (1.0 - metal) * (1.0 - trans);

@@ -92,7 +92,8 @@ CAUSTICA_CONST uint kPunctualPoint = 0u;
 CAUSTICA_CONST uint kPunctualSpot = 1u;
 CAUSTICA_CONST uint kPunctualDirectional = 2u;
 CAUSTICA_CONST uint kMatAlphaTexture = 8u;   // alphaMode BLEND or MASK: the base-colour texture's alpha multiplies baseColor.a
-CAUSTICA_CONST uint kMatAlphaMask = 16u;     // alphaMode MASK with a texture: opaque where alpha >= cutoff (tex2.w), else absent
+CAUSTICA_CONST uint kMatAlphaMask = 16u;     // alphaMode MASK with a texture or vertex alpha: opaque where alpha >= cutoff (tex2.w), else absent
+CAUSTICA_CONST uint kMatVertexAlpha = 32u;   // alphaMode BLEND or MASK in a scene with vertex colours: COLOR_0's alpha multiplies baseColor.a
 
 // EnvironmentParams.size.z: what camera rays that leave the scene see
 CAUSTICA_CONST uint kBackgroundEnvironment = 0u;  // the environment (black if there is none)
@@ -178,14 +179,20 @@ struct TriGeom {
 };
 
 // Triangle shading attributes, fetched only for the closest hit (glsl/lib/tri_shade.glsl): the TriShade
-// SSBO is a uint[] with kTriShadeWords words per triangle, kTriShadeWordsTextured in scenes with textures
-// (CAUSTICA_TEXTURES), in TriGeom order:
-//   words 0..2: vertex normals 0..2 (world space, unit), octahedral, packSnorm2x16 (octEncode);
+// SSBO is a uint[] in TriGeom order, per triangle the normals and then only the blocks the scene needs
+// (TriShadeLayout in app/accel/gpu_scene.h; the defines CAUSTICA_TRISHADE_TEXCOORDS, _COLORS, _TANGENTS):
+//   3 words, always: vertex normals 0..2 (world space, unit), octahedral, packSnorm2x16 (octEncode);
 //               kOctZeroNormal: no normal (the geometric normal is used)
-//   words 3..8 (textured scenes only): texcoords u0, v0, u1, v1, u2, v2 (float bits)
-// 12 bytes per triangle without textures (was 64), 36 with.
+//   6 words, textured scenes: texcoords u0, v0, u1, v1, u2, v2 (float bits)
+//   6 words, scenes with vertex colours (COLOR_0): corner k's packHalf2x16(r, g), packHalf2x16(b, a)
+//   3 words, scenes with TANGENTs on normal-mapped meshes: corner k's unit tangent (world space),
+//               octahedral, with bit 0 set where the bitangent sign w is negative; kOctZeroNormal: none
+// Every block a multiple of 3 words (one RGB32UI texel). 12 bytes per triangle without textures, 36 with.
 CAUSTICA_CONST uint kTriShadeWords = 3u;
 CAUSTICA_CONST uint kTriShadeWordsTextured = 9u;
+CAUSTICA_CONST uint kTriShadeTexcoordWords = 6u;
+CAUSTICA_CONST uint kTriShadeColorWords = 6u;
+CAUSTICA_CONST uint kTriShadeTangentWords = 3u;
 CAUSTICA_CONST uint kOctZeroNormal = 0x80008000u;  // snorm -32768 twice: never produced by octEncode
 
 // Material after the glTF material contract (docs/materials.md), 192 bytes: the first seven texels are
@@ -252,9 +259,9 @@ CAUSTICA_CONST uint kLightNodeInstanceShift = 2u;  // instanced scenes: a leaf's
 // Per-dispatch parameters (std140: vec4/uvec4 only).
 struct FrameParams {
   vec4 camPos;      // xyz: eye position (world space)
-  vec4 camRight;    // xyz: right axis scaled by tan(yfov/2) * aspect
-  vec4 camUp;       // xyz: up axis scaled by tan(yfov/2)
-  vec4 camForward;  // xyz: unit viewing direction
+  vec4 camRight;    // xyz: right axis scaled by tan(yfov/2) * aspect (orthographic: half the image width)
+  vec4 camUp;       // xyz: up axis scaled by tan(yfov/2) (orthographic: half the image height, scene units)
+  vec4 camForward;  // xyz: unit viewing direction; w: 1 for an orthographic camera, else 0
   uvec4 frame;      // x: width, y: height, z: index of the first sample of this dispatch, w: seed
   uvec4 options;    // x: max depth, y: live tiles in the tile list (0: the dispatch covers `tile`; else one
                     //    8x8 work group per 64 / side^2 listed tiles, adaptive sampling), z: emitter count, w: samples per pixel

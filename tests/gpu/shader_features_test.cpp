@@ -120,10 +120,10 @@ TEST_CASE("shader features: every row is documented in docs/shader-features.md, 
 TEST_CASE("shader features: every row is read by a shader that compiles it, and every feature #ifdef of the shaders is a row") {
   ShaderLibrary library;
   // Names the data sets, not the table: the storage layout's (SceneBufferLayout::defines, here for a
-  // split, textured layout), the instanced traversal's (GpuScene::instanceDefines) and the denoiser's
-  // stages (denoiseStageDefines).
+  // split layout holding every TriShade block), the instanced traversal's (GpuScene::instanceDefines)
+  // and the denoiser's stages (denoiseStageDefines).
   SceneBufferLayout layout;
-  layout.texcoords = true;
+  layout.shade.texcoords = layout.shade.colors = layout.shade.tangents = true;
   for (SplitArray* a : {&layout.nodes, &layout.triGeom, &layout.triShade}) {
     a->parts = 2;
     a->bindings = {7};
@@ -280,8 +280,8 @@ TEST_CASE("shader features: a variant compiles the rows its mode reads, its sett
   s.integrator = Integrator::Naive;  // no mis: no casters, no no-emitter variant (both need it)
   CHECK(joined(variantFeatures(everyRow(), s).defines()) ==
         "CAUSTICA_MIRROR CAUSTICA_GLASS CAUSTICA_VOLUME CAUSTICA_DISPERSION CAUSTICA_TEXTURES CAUSTICA_OPACITY "
-        "CAUSTICA_ENV CAUSTICA_PUNCTUAL CAUSTICA_SPOT_EMITTERS CAUSTICA_GGX CAUSTICA_CLEARCOAT CAUSTICA_SHEEN "
-        "CAUSTICA_FACTOR_TEXTURES CAUSTICA_TRANSPARENT");
+        "CAUSTICA_VERTEX_COLORS CAUSTICA_ENV CAUSTICA_PUNCTUAL CAUSTICA_SPOT_EMITTERS CAUSTICA_GGX CAUSTICA_CLEARCOAT "
+        "CAUSTICA_SHEEN CAUSTICA_FACTOR_TEXTURES CAUSTICA_TRANSPARENT");
 
   s = path;
   s.mode = RenderMode::Whitted;  // scene and image rows only; --all-features is the path tracer's

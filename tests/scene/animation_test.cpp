@@ -244,6 +244,17 @@ TEST_CASE("animation: a key time equals the static file with that pose, bit for 
   }
 }
 
+TEST_CASE("animation: posed animations, skins and morph targets are not named in the 'not rendered' line") {
+  for (const char* name : {"trs.gltf", "morph.gltf", "skin.gltf"}) {
+    CAPTURE(std::string(name));
+    const Scene s = load(name, 0.5);
+    for (const std::string& w : s.warnings) {
+      CAPTURE(w);
+      CHECK(w.find("not rendered") == std::string::npos);
+    }
+  }
+}
+
 TEST_CASE("animation: morph-target weights blend positions and normals") {
   // Triangles: floor (2), then the strip (4). Weights go linearly from (0, 0) to (1, 0.5) over 0..1 s.
   const Scene s = load("morph.gltf", 0.5);  // weights (0.5, 0.25)

@@ -20,147 +20,17 @@
 
 #include "util/error.h"
 #include "scene/scene.h"
+#include "gltf_builder.h"
 
 namespace {
 
 using caustica::Scene;
-using nlohmann::json;
-namespace fs = std::filesystem;
-
-constexpr int kByte = 5121, kShort = 5123, kUint = 5125, kFloat = 5126;
-
-std::string source(const std::string& relative) { return caustica::sourceDir() + "/" + relative; }
-
-// A fresh directory under the system temp dir, removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("caustica_scene_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& bytes) const {
-    const fs::path file = path / name;
-    std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
-    return file.string();
-  }
-};
-
-std::string base64(const std::string& in) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const std::uint32_t v = std::uint32_t(std::uint8_t(in[i])) << 16 | std::uint32_t(std::uint8_t(in[i + 1])) << 8 |
-                            std::uint8_t(in[i + 2]);
-    for (int k = 3; k >= 0; --k) out += table[(v >> (6 * k)) & 63];
-  }
-  if (i < in.size()) {
-    std::uint32_t v = std::uint32_t(std::uint8_t(in[i])) << 16;
-    if (i + 1 < in.size()) v |= std::uint32_t(std::uint8_t(in[i + 1])) << 8;
-    out += table[(v >> 18) & 63];
-    out += table[(v >> 12) & 63];
-    out += i + 1 < in.size() ? table[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
-
-// Builds small glTF documents with one embedded buffer.
-struct Gltf {
-  json doc = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", json::array({{{"nodes", json::array()}}})}};
-  std::string bin;
-
-  template <class T>
-  int accessor(const std::vector<T>& values, int componentType, const char* type, bool normalized = false) {
-    while (bin.size() % 4) bin += '\0';
-    doc["bufferViews"].push_back(
-        {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", values.size() * sizeof(T)}});
-    bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-    const std::size_t components = std::string(type) == "SCALAR" ? 1 : std::size_t(type[3] - '0');
-    json acc = {{"bufferView", doc["bufferViews"].size() - 1},
-                {"componentType", componentType},
-                {"count", values.size() / components},
-                {"type", type}};
-    if (normalized) acc["normalized"] = true;
-    doc["accessors"].push_back(acc);
-    return int(doc["accessors"].size() - 1);
-  }
-  // POSITION accessors carry min and max, as glTF requires (the loader's rebase reads them).
-  int positions(const std::vector<float>& xyz) {
-    const int index = accessor(xyz, kFloat, "VEC3");
-    std::vector<float> lo(3, std::numeric_limits<float>::infinity()), hi(3, -std::numeric_limits<float>::infinity());
-    for (std::size_t i = 0; i < xyz.size(); ++i) {
-      lo[i % 3] = std::min(lo[i % 3], xyz[i]);
-      hi[i % 3] = std::max(hi[i % 3], xyz[i]);
-    }
-    if (!xyz.empty()) {
-      doc["accessors"][std::size_t(index)]["min"] = lo;
-      doc["accessors"][std::size_t(index)]["max"] = hi;
-    }
-    return index;
-  }
-
-  int add(const char* array, const json& value) {
-    doc[array].push_back(value);
-    return int(doc[array].size() - 1);
-  }
-  int mesh(const json& primitive) { return add("meshes", {{"primitives", json::array({primitive})}}); }
-  int root(const json& node) {
-    const int index = add("nodes", node);
-    doc["scenes"][0]["nodes"].push_back(index);
-    return index;
-  }
-  int diffuse() { return add("materials", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}); }
-
-  std::string text() {
-    json d = doc;
-    d["buffers"] = json::array(
-        {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
-    return d.dump();
-  }
-  Scene load(const TempDir& dir, const std::string& name = "scene.gltf") {
-    return caustica::loadScene(dir.write(name, text()));
-  }
-};
-
-// A unit right triangle in the z = 0 plane, counter-clockwise seen from +z, with normals +z.
-const std::vector<float> kTriangle = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-const std::vector<float> kTriangleNormals = {0, 0, 1, 0, 0, 1, 0, 0, 1};
-
-glm::vec3 geometricNormal(const caustica::Triangle& t) {
-  return glm::normalize(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]));
-}
-
-bool near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) { return glm::length(a - b) <= eps; }
-
-// The error message for loading `path`, checking that only caustica::Error is thrown.
-std::string loadError(const std::string& path) {
-  try {
-    caustica::loadScene(path);
-  } catch (const caustica::Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    FAIL("non-caustica exception for ", path, ": ", e.what());
-  }
-  return "";
-}
+using namespace caustica::test;
 
 const caustica::Material* findMaterial(const Scene& s, const std::string& name) {
   for (const auto& m : s.materials)
     if (m.name == name) return &m;
   return nullptr;
-}
-
-bool hasWarning(const Scene& s, const std::string& text) {
-  for (const auto& w : s.warnings)
-    if (w.find(text) != std::string::npos) return true;
-  return false;
 }
 
 }  // namespace
@@ -663,15 +533,15 @@ TEST_CASE("material contract: alpha modes, emission strength, glass extensions, 
   for (const auto& w : s.warnings) CHECK(w.rfind(s.path + ": ", 0) == 0);
 
   SUBCASE("a required unsupported extension is an error") {
-    g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
-    g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    g.doc["extensionsUsed"] = {"KHR_texture_basisu"};
+    g.doc["extensionsRequired"] = {"KHR_texture_basisu"};
     const std::string error = loadError(dir.write("transform.gltf", g.text()));
     CHECK(error.find("transform.gltf: ") != std::string::npos);
-    CHECK(error.find("KHR_draco_mesh_compression") != std::string::npos);
+    CHECK(error.find("KHR_texture_basisu") != std::string::npos);
   }
 }
 
-TEST_CASE("cameras: perspective parameters, world transform, traversal order, automatic camera") {
+TEST_CASE("cameras: perspective and orthographic parameters, world transform, traversal order, automatic camera") {
   TempDir dir;
   Gltf g;
   g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}})}});
@@ -680,7 +550,7 @@ TEST_CASE("cameras: perspective parameters, world transform, traversal order, au
                     {"type", "perspective"},
                     {"perspective", {{"yfov", 0.9}, {"aspectRatio", 1.5}, {"znear", 0.1}}}});
   g.add("cameras", {{"name", "ortho"}, {"type", "orthographic"},
-                    {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}});
+                    {"orthographic", {{"xmag", 3}, {"ymag", -1.5}, {"znear", 0.1}, {"zfar", 10}}}});
   const double r = std::sqrt(0.5);
   // "first" sits in a node that is traversed before the node holding "second", despite array order.
   g.root({{"camera", 1}, {"translation", {1, 2, 3}}, {"rotation", {0.0, r, 0.0, r}}});  // 90 deg about +y
@@ -688,8 +558,9 @@ TEST_CASE("cameras: perspective parameters, world transform, traversal order, au
   g.root({{"translation", {0, 0, 7}}, {"children", {inner}}});
   g.root({{"camera", 2}});
   const Scene s = g.load(dir);
-  REQUIRE(s.cameras.size() == 2);
+  REQUIRE(s.cameras.size() == 3);
   CHECK(s.cameras[0].name == "first");
+  CHECK(!s.cameras[0].orthographic());
   CHECK(s.cameras[0].yfov == doctest::Approx(0.9));
   CHECK(s.cameras[0].aspect == doctest::Approx(1.5));
   CHECK(near(s.cameras[0].position, glm::vec3(1, 2, 3)));
@@ -698,7 +569,16 @@ TEST_CASE("cameras: perspective parameters, world transform, traversal order, au
   CHECK(s.cameras[1].name == "second");
   CHECK(s.cameras[1].aspect == 0.0f);
   CHECK(near(s.cameras[1].position, glm::vec3(0, 0, 7)));
-  CHECK(hasWarning(s, "orthographic"));
+  // Orthographic: half height ymag (its sign carries nothing), the file's aspect xmag / ymag.
+  CHECK(s.cameras[2].name == "ortho");
+  CHECK(s.cameras[2].orthographic());
+  CHECK(s.cameras[2].orthoHeight == 1.5f);
+  CHECK(s.cameras[2].aspect == 2.0f);
+  CHECK(!hasWarning(s, "orthographic"));
+  SUBCASE("a zero ymag is refused") {
+    g.doc["cameras"][2]["orthographic"]["ymag"] = 0;
+    CHECK(loadError(dir.write("ortho0.gltf", g.text())).find("cameras[2].orthographic.ymag is 0") != std::string::npos);
+  }
 
   const caustica::Bounds bounds{glm::vec3(-1.0f, 0.0f, -3.0f), glm::vec3(1.0f, 2.0f, 1.0f)};
   const caustica::Camera automatic = caustica::autoCamera(bounds);
@@ -1004,6 +884,19 @@ TEST_CASE("bad input files throw caustica::Error naming the file and the problem
       {"huge-accessor-count.gltf", "declared triangles to 1000000000000000, more than the limit of 16777216"},
       {"wide-node-tree.gltf", "nodes[17] (meshes[1]) brings the scene's declared triangles to 17000001"},
       {"deep-node-tree.gltf", "nodes[1023]: its world transform is not finite"},
+      // Malformed compressed data (scripts/make-wild-data --corrupt, from tests/data/wild/).
+      {"draco-truncated.glb", "KHR_draco_mesh_compression: the Draco data cannot be decoded"},
+      {"draco-not-draco.glb", "KHR_draco_mesh_compression: not Draco data"},
+      {"draco-count-mismatch.glb", "the Draco mesh has 4 points, but the accessor's count is 5"},
+      {"draco-unknown-attribute.glb", "attributes.POSITION names no attribute of the Draco mesh"},
+      {"meshopt-corrupt-vertices.glb", "EXT_meshopt_compression: the compressed data is corrupt (meshoptimizer's "
+                                       "ATTRIBUTES decoder"},
+      {"meshopt-truncated-indices.glb", "the compressed data is corrupt (meshoptimizer's TRIANGLES decoder"},
+      {"meshopt-bad-stride.glb", "EXT_meshopt_compression.byteStride is 6; ATTRIBUTES need a multiple of 4"},
+      {"meshopt-filter-stride.glb", "does not suit filter QUATERNION"},
+      {"meshopt-image-in-fallback.glb", "images[0] lies in buffers[1], an EXT_meshopt_compression fallback buffer"},
+      {"quantized-undeclared.glb", "has component type normalized SHORT; allowed: FLOAT"},
+      {"webp-corrupt.glb", "images[0] could not be loaded: not a decodable WebP image"},
   };
   for (const Case& c : cases) {
     CAPTURE(std::string(c.file));
@@ -1330,4 +1223,56 @@ TEST_CASE("instancing: autoInstances keeps instances only where flattening multi
       CHECK(flat.triangles[i].p[k] == four.triangles[i].p[k]);
       CHECK(flat.triangles[i].normalWord[k] == four.triangles[i].normalWord[k]);
     }
+}
+
+TEST_CASE("nothing dropped in silence: what is not rendered is named in one warning line") {
+  TempDir dir;
+  Gltf g;
+  const int pos = g.positions(kTriangle);
+  const int colors = g.accessor(std::vector<float>{1, 1, 1, 1, 1, 1, 1, 1, 1}, kFloat, "VEC3");
+  const int uv2 = g.accessor(std::vector<float>{0, 0, 1, 0, 0, 1}, kFloat, "VEC2");
+  const int mat = g.add("materials", {{"name", "aged"}, {"occlusionTexture", {{"index", 0}}}});
+  const unsigned char png[4] = {255, 255, 255, 255};
+  REQUIRE(stbi_write_png((dir.path / "ao.png").string().c_str(), 1, 1, 4, png, 4));
+  g.doc["images"] = {{{"uri", "ao.png"}}};
+  g.doc["textures"] = {{{"source", 0}}};
+  const int mesh = g.mesh({{"attributes", {{"POSITION", pos}, {"COLOR_1", colors}, {"TEXCOORD_2", uv2},
+                                           {"_BATCHID", colors}}},
+                           {"material", mat}});
+  g.root({{"mesh", mesh}});
+  g.doc["scenes"].push_back({{"nodes", json::array()}});
+  g.doc["extensionsUsed"] = {"KHR_materials_iridescence", "KHR_materials_sheen", "KHR_materials_clearcoat",
+                             "KHR_materials_unlit", "KHR_animation_pointer"};
+  const Scene s = g.load(dir);
+  std::vector<std::string> lines;
+  for (const std::string& w : s.warnings)
+    if (w.find("not rendered: ") != std::string::npos) lines.push_back(w);
+  REQUIRE(lines.size() == 1);
+  const std::string& line = lines[0];
+  CHECK(line.rfind(s.path + ": not rendered: ", 0) == 0);
+  for (const char* rendered : {"clearcoat", "sheen", "unlit", "specular", "transmission"}) {  // the layers are rendered
+    CAPTURE(std::string(rendered));
+    CHECK(line.find(rendered) == std::string::npos);
+  }
+  for (const char* named : {"extension(s) KHR_animation_pointer, KHR_materials_iridescence",
+                            "vertex attribute(s) COLOR_1, TEXCOORD_2, _BATCHID",
+                            "1 scene(s) besides the default one", "'aged': occlusionTexture"}) {
+    CAPTURE(std::string(named));
+    CHECK(line.find(named) != std::string::npos);
+  }
+  SUBCASE("a file with nothing unsupported gets no such line") {
+    Gltf plain;
+    const int m = plain.diffuse();
+    plain.root({{"mesh", plain.mesh({{"attributes", {{"POSITION", plain.positions(kTriangle)}}}, {"material", m}})}});
+    for (const std::string& w : plain.load(dir, "plain.gltf").warnings) CHECK(w.find("not rendered") == std::string::npos);
+  }
+}
+
+TEST_CASE("a negative index is named with its value") {
+  TempDir dir;
+  Gltf g;
+  g.root({{"mesh", -1}});
+  const std::string error = loadError(dir.write("negative.gltf", g.text()));
+  CHECK(error.find("nodes[0].mesh is -1; it must be a non-negative integer") != std::string::npos);
+  CHECK(error.find("but it is an integer") == std::string::npos);
 }

@@ -160,7 +160,7 @@ TEST_CASE("environment files: .hdr and .exr read with strength; bad input named;
   CHECK(e.rotationDegrees == 15.0f);
   CHECK(e.describe().find("2x2, strength 2, rotation 15 deg") != std::string::npos);
 
-  // .exr through tinyexr (linear float, no quantisation).
+  // .exr through OpenEXR (linear float, no quantisation).
   fs::path exr = fs::temp_directory_path() / "caustica_env_test.exr";
   Image img{2, 2, px};
   writeImage(exr.string(), img);

@@ -38,7 +38,7 @@ std::string referenceKeyText(const ReferenceKey& key) {
        << rs.casterProbability << "\ncamera " << key.cameraIndex << ' ' << camera.position.x << ' '
        << camera.position.y << ' ' << camera.position.z << ' ' << camera.forward.x << ' ' << camera.forward.y << ' '
        << camera.forward.z << ' ' << camera.up.x << ' ' << camera.up.y << ' ' << camera.up.z << ' ' << camera.yfov
-       << '\n'
+       << (camera.orthographic() ? " orthographic " + std::to_string(camera.orthoHeight) : std::string()) << '\n'
        << hex64(key.shaderHash) << '\n';
   return text.str();
 }

@@ -102,8 +102,9 @@ void CameraController::look(float yaw, float pitch) { turn(yaw, pitch, false); }
 void CameraController::pan(float dx, float dy) {
   if (dx == 0.0f && dy == 0.0f) return;
   glm::vec3 right = glm::normalize(glm::cross(camera_.forward, camera_.up));
-  // One image height at the target depth spans 2 tan(yfov/2) * distance scene units.
-  float span = 2.0f * std::tan(0.5f * camera_.yfov) * distance_;
+  // One image height at the target depth spans 2 tan(yfov/2) * distance scene units (orthographic:
+  // twice its half height, at any depth).
+  float span = camera_.orthographic() ? 2.0f * camera_.orthoHeight : 2.0f * std::tan(0.5f * camera_.yfov) * distance_;
   camera_.position += (-dx * right + dy * camera_.up) * span;
   ++revision_;
 }
@@ -112,8 +113,10 @@ void CameraController::dolly(float steps) {
   if (steps == 0.0f) return;
   glm::vec3 pivot = target();
   float minDistance = 1e-4f * sceneSize_;
+  const float before = distance_;
   distance_ = std::max(distance_ * std::pow(7.0f / 8.0f, steps), minDistance);
   camera_.position = pivot - camera_.forward * distance_;
+  if (camera_.orthographic()) camera_.orthoHeight *= distance_ / before;  // parallel rays: zoom instead
   ++revision_;
 }
 

@@ -180,9 +180,14 @@ void Viewer::present() {
   if (showPreviewCopy_ && !pacer_.previewing() && renderer_->samplesPerPixel() == 0) finishedRows = pacer_.passRow();
   const bool denoised = showDenoised();
   presenter_.draw(*renderer_, controls_.tone, ww, wh, finishedRows, denoised);
-  if (denoised) {  // the denoiser's share of the frame (Renderer::denoiseMs: it waits for the GPU)
-    // The first run is left out: llvmpipe compiles the programs at their first dispatch (about a second).
-    if (denoised_ > 0) denoiseMs_ += (denoised_ == 1 ? 1.0 : 0.1) * (renderer_->denoiseMs() - denoiseMs_);
+  const double filterMs = renderer_->denoiseMsTotal() - filterMsSeen_;  // this frame's filter runs (they wait for the GPU)
+  filterMsSeen_ = renderer_->denoiseMsTotal();
+  if (denoised) {
+    // The first is left out: llvmpipe compiles the programs at their first dispatch (about a second).
+    if (denoised_ > 0) {
+      denoiseMs_ += (denoised_ == 1 ? 1.0 : 0.1) * (filterMs - denoiseMs_);
+      filterMsSum_ += filterMs;
+    }
     ++denoised_;
   }
   pacer_.recordDisplay((now() - t) * 1000.0, presented_);
@@ -292,6 +297,9 @@ int Viewer::run() {
   const double loopSeconds = now() - loopStart;
   const std::uint64_t loopSamples = samples_;
   const int loopPresented = presented_;
+  // The filter's mean time per shown frame over the same frames as the loop's figures (not finishPass's).
+  const double loopFilterMs = denoised_ > 1 ? filterMsSum_ / (denoised_ - 1) : 0.0;
+  const int loopDenoised = denoised_;
   if (config_.frameLimit > 0 && !closed) finishPass();
   if (config_.frameLimit > 0) {
     updateTitle(true);
@@ -300,7 +308,8 @@ int Viewer::run() {
                 loopPresented / std::max(loopSeconds, 1e-9), static_cast<double>(loopSamples) / std::max(loopSeconds, 1e-9),
                 renderer_->settings().width, renderer_->settings().height, renderer_->samplesPerPixel(),
                 std::isfinite(estimate_) ? format(", relMSE~%.3g", estimate_).c_str() : "",
-                denoised_ > 1 ? format("; denoised, %.1f ms a shown frame", denoiseMs_).c_str() : denoised_ ? "; denoised" : "; raw");
+                loopDenoised > 1 ? format("; denoised, filter %.1f ms a shown frame", loopFilterMs).c_str()
+                                 : loopDenoised ? "; denoised" : "; raw");
     if (controls_.stopAtTarget && done()) std::printf("target relMSE %.3g reached\n", controls_.targetError);
   }
   if (!config_.screenshotPath.empty()) {

@@ -91,8 +91,12 @@ class Viewer {
   double lastTitle_ = -1.0, rateT0_ = 0.0;  // seconds
   std::uint64_t rateS0_ = 0;
   double samplesPerSecond_ = 0.0;
-  double denoiseMs_ = 0.0;     // moving average of the denoiser's time per shown frame, milliseconds
-  int denoised_ = 0;           // frames shown denoised
+  // The filter's time per shown denoised frame (every denoise() since the frame before: the display's
+  // and a preview copy's), milliseconds; the first (llvmpipe compiles the programs then) left out.
+  double denoiseMs_ = 0.0;       // moving average, for the title
+  double filterMsSeen_ = 0.0;    // Renderer::denoiseMsTotal() at the last shown frame
+  double filterMsSum_ = 0.0;     // sum over the shown denoised frames counted
+  int denoised_ = 0;             // frames shown denoised
 };
 
 #endif  // CAUSTICA_HAVE_GLFW
