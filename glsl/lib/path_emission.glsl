@@ -32,6 +32,6 @@ void addEmission(inout PathState s, Surface sf) {
       w *= powerHeuristic(s.prevPdf, pdfLight);
     }
 #endif
-    s.radiance += s.beta * s.filt * materialEmission(sf.m, sf.uv) * w;
+    s.radiance += s.beta * s.filt * materialEmissionSeen(sf.m, sf.uv, dot(sf.ngFront, s.dir)) * w;
   }
 }
