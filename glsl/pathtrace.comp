@@ -73,11 +73,11 @@ bool pathBounce(inout PathState s) {
 #endif
   Surface sf;
   if (!surfaceAt(hit, s.dir, true, sf)) return false;  // surface.glsl
-  addEmission(s, sf);                                  // path_emission.glsl: with its MIS weight
   vec4 base = materialBaseColor(sf.m, sf.uv, sf.color);
 #ifdef CAUSTICA_OPACITY
-  if (passThrough(s, sf, base.a)) return true;  // path_scatter.glsl: an alpha cut-out
+  if (passThrough(s, sf, base.a)) return true;  // path_scatter.glsl: an alpha cut-out (absent: no emission either)
 #endif
+  addEmission(s, sf);                           // path_emission.glsl: with its MIS weight
   BounceLobe lobe = chooseBounceLobe(s, sf, base.rgb);  // path_scatter.glsl
   bool nonDelta = isDiffuseLobe(lobe) || isGlossyLobe(lobe);
 #ifdef CAUSTICA_AOV

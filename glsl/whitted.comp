@@ -113,20 +113,30 @@ vec3 traceWhitted(uvec2 pixel, inout uvec4 rng) {
     Surface sf;
     if (!surfaceAt(hit, r.dir, false, sf)) continue;  // surface.glsl (Phong shading takes no normal map)
 
-    if (surfaceEmits(sf)) radiance += w * materialEmission(sf.m, sf.uv);
-
     vec4 base = materialBaseColor(sf.m, sf.uv, sf.color);
     float alpha = 1.0;
 #ifdef CAUSTICA_OPACITY
     alpha = base.a;
     if (alpha < 1.0) pushRay(offsetRayOrigin(sf.p, sf.pError, -sf.ng), r.dir, w * (1.0 - alpha), r.sigma, r.depth);
 #endif
+#ifdef CAUSTICA_CLEARCOAT
+    // The clear coat: a mirror reflection about the coat normal with its Fresnel weight; the material
+    // below gets the rest (the sheen is not drawn in this mode).
+    float coatWeight = alpha * materialCoat(sf.m, sf.uv).x * coatFresnel(dot(r.dir, sf.nc));
+    if (r.depth + 1u < maxDepth && coatWeight > 0.0) {
+      vec3 rc = reflect(r.dir, sf.nc);
+      if (dot(rc, sf.ng) <= 0.0) rc = reflect(r.dir, sf.ng);
+      pushRay(offsetRayOrigin(sf.p, sf.pError, sf.ng), rc, w * coatWeight, r.sigma, r.depth + 1u);
+    }
+    w *= 1.0 - coatWeight;
+#endif
+    if (surfaceEmits(sf)) radiance += w * alpha * materialEmission(sf.m, sf.uv);  // present with its opacity
     float metal = 0.0, trans = 0.0;
 #ifdef CAUSTICA_MIRROR
     metal = sf.m.params.x;
 #endif
 #ifdef CAUSTICA_GLASS
-    trans = sf.m.params.z;
+    trans = materialTransmission(sf.m, sf.uv);
 #endif
     float diffuseWeight = alpha * (1.0 - metal) * (1.0 - trans);
     if (diffuseWeight > 0.0)

@@ -172,6 +172,15 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
     gm.specular = glm::vec4(m.specularF0, m.specularF90);
     gm.tex2 = glm::uvec4(texIndex(m.metallicRoughnessTexture), texIndex(m.normalTexture),
                          floatBits(m.normalScale), floatBits(m.alphaCutoff));
+    const bool coat = m.hasClearcoat(), sheen = m.hasSheen();
+    gm.coat = coat ? glm::vec4(m.clearcoat, m.clearcoatRoughness, m.clearcoatNormalScale, 0.0f) : glm::vec4(0.0f);
+    gm.sheen = sheen ? glm::vec4(m.sheenColor, m.sheenRoughness) : glm::vec4(0.0f);
+    gm.tex3 = glm::uvec4(texIndex(coat ? m.clearcoatTexture : -1), texIndex(coat ? m.clearcoatRoughnessTexture : -1),
+                         texIndex(coat ? m.clearcoatNormalTexture : -1), texIndex(sheen ? m.sheenColorTexture : -1));
+    gm.tex4 = glm::uvec4(texIndex(sheen ? m.sheenRoughnessTexture : -1), texIndex(m.specularTexture),
+                         texIndex(m.specularColorTexture), texIndex(m.transmissionTexture));
+    const float r = (m.ior - 1.0f) / (m.ior + 1.0f);
+    gm.specularBase = glm::vec4(r * r * m.specularColorFactor, m.specularFactor);
     g.materials.push_back(gm);
   }
   for (const SpotEmitter& e : scene.spotEmitters) {  // --light-radius spheres of spot lights

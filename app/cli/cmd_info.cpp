@@ -28,7 +28,10 @@ std::string materialKind(const Material& m) {
   else kind = m.specularF90 > 0.0f ? "plastic (specular layer over diffuse)" : "diffuse";
   if (rough && m.transmission > 0.0f && m.metallic < 1.0f) kind += " (rough glass)";
   if (m.dispersion > 0.0f) kind += " +dispersion";
+  if (m.hasSheen()) kind += " +sheen";
+  if (m.hasClearcoat()) kind += " +clear coat";
   if (m.baseColor.a < 1.0f) kind += " +opacity";
+  if (m.unlit) return "unlit (emits its base colour)" + std::string(m.baseColor.a < 1.0f ? " +opacity" : "");
   if (m.isEmissive()) kind = "emitter, " + kind;
   return kind;
 }

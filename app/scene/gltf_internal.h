@@ -200,6 +200,9 @@ class SceneBuilder {
   std::set<int> materialTexCoords_;  // UV sets the textures of the material being converted name
   int texture(const tinygltf::TextureInfo& info, const std::string& at);
   int texture(const tinygltf::NormalTextureInfo& info, const std::string& at);
+  // The texture an extension object names under `key` (a textureInfo, KHR_texture_transform included),
+  // as texture() does for core references; -1 when absent.
+  int extTexture(const tinygltf::Value* ext, const char* key, const std::string& at);
   std::uint32_t defaultMaterial(const std::string& at);
 
   // ---- animation (gltf_animation.cpp) ----

@@ -20,7 +20,8 @@ using Json = nlohmann::json;
 
 const char* const kSupportedExtensions[] = {
     "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
-    "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_texture_transform",
+    "KHR_materials_dispersion", "KHR_materials_emissive_strength", "KHR_materials_specular",
+    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit", "KHR_texture_transform",
     "KHR_lights_punctual", "EXT_mesh_gpu_instancing", "EXT_texture_webp", "KHR_mesh_quantization",
     "EXT_meshopt_compression", "KHR_draco_mesh_compression"};
 
@@ -595,6 +596,22 @@ class JsonChecker {
       textureInfo(*e, sat, "specularTexture");
       textureInfo(*e, sat, "specularColorTexture");
     }
+    if (const Json* e = object(*ext, eat, "KHR_materials_clearcoat")) {
+      const std::string cat = join(eat, "KHR_materials_clearcoat");
+      number(*e, cat, "clearcoatFactor");
+      number(*e, cat, "clearcoatRoughnessFactor");
+      textureInfo(*e, cat, "clearcoatTexture");
+      textureInfo(*e, cat, "clearcoatRoughnessTexture");
+      textureInfo(*e, cat, "clearcoatNormalTexture");
+    }
+    if (const Json* e = object(*ext, eat, "KHR_materials_sheen")) {
+      const std::string sat = join(eat, "KHR_materials_sheen");
+      numbers(*e, sat, "sheenColorFactor", 3);
+      number(*e, sat, "sheenRoughnessFactor");
+      textureInfo(*e, sat, "sheenColorTexture");
+      textureInfo(*e, sat, "sheenRoughnessTexture");
+    }
+    object(*ext, eat, "KHR_materials_unlit");
     if (const Json* e = object(*ext, eat, "KHR_materials_dispersion"))
       number(*e, join(eat, "KHR_materials_dispersion"), "dispersion");
     if (const Json* e = object(*ext, eat, "KHR_materials_emissive_strength"))

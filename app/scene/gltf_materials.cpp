@@ -21,6 +21,25 @@ double extNumber(const tinygltf::Value* ext, const char* key, double fallback) {
 
 bool extHas(const tinygltf::Value* ext, const char* key) { return ext && ext->Has(key); }
 
+// KHR_materials_unlit: the surface shows its base colour whatever the lighting (docs/materials.md). A
+// path tracer's only such surface is an emitter that reflects nothing: it emits the base colour (factor
+// x texture; alpha, MASK and doubleSided as for any material) and every other property, emission
+// included, is the fallback for viewers without the extension and is not used.
+void makeUnlit(Material& m) {
+  Material u;
+  u.name = m.name;
+  u.unlit = true;
+  u.emission = glm::vec3(m.baseColor);
+  u.emissiveTexture = m.baseColorTexture;
+  u.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, m.baseColor.a);
+  u.alphaFromTexture = m.alphaFromTexture;
+  u.alphaCutoff = m.alphaCutoff;
+  if (m.alphaFromTexture) u.baseColorTexture = m.baseColorTexture;  // for its alpha only
+  u.doubleSided = m.doubleSided;
+  u.roughness = 1.0f;  // black Lambertian: no specular layer (specularF90 0), no metal, no glass
+  m = u;
+}
+
 void wrapMode(int mode, bool& repeat, bool& mirror) {
   repeat = mode != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
   mirror = mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT;
@@ -155,7 +174,7 @@ Material SceneBuilder::convertMaterial(int index) {
 
   if (const tinygltf::Value* t = extension(m.extensions, "KHR_materials_transmission")) {
     out.transmission = float(unit(extNumber(t, "transmissionFactor", 0.0), at + ".transmissionFactor"));
-    ignore(extHas(t, "transmissionTexture"), "transmissionTexture");
+    if (out.transmission > 0.0f) out.transmissionTexture = extTexture(t, "transmissionTexture", at);
   }
   if (const tinygltf::Value* e = extension(m.extensions, "KHR_materials_ior")) {
     const double ior = extNumber(e, "ior", 1.5);
@@ -191,18 +210,52 @@ Material SceneBuilder::convertMaterial(int index) {
           }
           specularColor[c] = x;
         }
-      ignore(extHas(sp, "specularTexture"), "specularTexture");
-      ignore(extHas(sp, "specularColorTexture"), "specularColorTexture");
+      // Textures only where a specular layer can exist (the dielectric base; not a full metal or glass).
+      if (out.metallic < 1.0f && out.transmission < 1.0f) {
+        out.specularTexture = extTexture(sp, "specularTexture", at);
+        out.specularColorTexture = extTexture(sp, "specularColorTexture", at);
+      }
     }
     const double r = (double(out.ior) - 1.0) / (double(out.ior) + 1.0);
     out.specularF0 = glm::vec3(glm::min(r * r * specularColor, glm::dvec3(1.0)) * specularFactor);
     out.specularF90 = float(specularFactor);
+    out.specularColorFactor = glm::vec3(specularColor);
+    out.specularFactor = float(specularFactor);
+    // A specular texture can raise F90 from 0 only if the factor does: specularFactor 0 stays Lambertian.
+    if (out.specularF90 == 0.0f) out.specularTexture = out.specularColorTexture = -1;
+  }
+  if (const tinygltf::Value* c = extension(m.extensions, "KHR_materials_clearcoat")) {
+    out.clearcoat = float(unit(extNumber(c, "clearcoatFactor", 0.0), at + ".clearcoatFactor"));
+    out.clearcoatRoughness = float(unit(extNumber(c, "clearcoatRoughnessFactor", 0.0), at + ".clearcoatRoughnessFactor"));
+    if (out.clearcoat > 0.0f) {
+      out.clearcoatTexture = extTexture(c, "clearcoatTexture", at);
+      out.clearcoatRoughnessTexture = extTexture(c, "clearcoatRoughnessTexture", at);
+      out.clearcoatNormalTexture = extTexture(c, "clearcoatNormalTexture", at);
+      if (out.clearcoatNormalTexture >= 0) {
+        out.clearcoatNormalScale = float(extNumber(&c->Get("clearcoatNormalTexture"), "scale", 1.0));
+        if (!std::isfinite(out.clearcoatNormalScale)) fail(at + ".clearcoatNormalTexture.scale is not finite");
+      }
+    }
+  }
+  if (const tinygltf::Value* sh = extension(m.extensions, "KHR_materials_sheen")) {
+    if (extHas(sh, "sheenColorFactor") && sh->Get("sheenColorFactor").ArrayLen() == 3)
+      for (int c = 0; c < 3; ++c) {
+        const tinygltf::Value& v = sh->Get("sheenColorFactor").Get(c);
+        out.sheenColor[c] = float(unit(v.IsNumber() ? v.GetNumberAsDouble() : 0.0,
+                                       at + ".sheenColorFactor[" + str(std::uint64_t(c)) + "]"));
+      }
+    out.sheenRoughness = float(unit(extNumber(sh, "sheenRoughnessFactor", 0.0), at + ".sheenRoughnessFactor"));
+    if (out.hasSheen()) {
+      out.sheenColorTexture = extTexture(sh, "sheenColorTexture", at);
+      out.sheenRoughnessTexture = extTexture(sh, "sheenRoughnessTexture", at);
+    }
   }
   if (const tinygltf::Value* d = extension(m.extensions, "KHR_materials_dispersion")) {
     const double dispersion = extNumber(d, "dispersion", 0.0);
     if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
     else out.dispersion = float(dispersion);
   }
+  if (extension(m.extensions, "KHR_materials_unlit")) makeUnlit(out);
   if (!ignored.empty()) notRendered(at + " '" + oneLine(out.name) + "': " + ignored);
   // Triangles carry one UV set, so a material's textures must agree on theirs (TEXCOORD_0 or _1).
   if (materialTexCoords_.size() == 1 && (*materialTexCoords_.begin() == 0 || *materialTexCoords_.begin() == 1)) {
@@ -311,6 +364,20 @@ int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& 
   }
   textureMap_[info.index] = result;
   return result;
+}
+
+int SceneBuilder::extTexture(const tinygltf::Value* ext, const char* key, const std::string& at) {
+  if (!ext || !ext->Has(key) || !ext->Get(key).IsObject()) return -1;
+  const tinygltf::Value& v = ext->Get(key);
+  tinygltf::TextureInfo t;
+  if (!v.Has("index") || !v.Get("index").IsNumber()) return -1;  // the JSON check requires an integer index
+  t.index = v.Get("index").GetNumberAsInt();
+  if (v.Has("texCoord") && v.Get("texCoord").IsNumber()) t.texCoord = v.Get("texCoord").GetNumberAsInt();
+  if (v.Has("extensions") && v.Get("extensions").IsObject()) {
+    const tinygltf::Value& e = v.Get("extensions");
+    for (const std::string& name : e.Keys()) t.extensions[name] = e.Get(name);
+  }
+  return texture(t, at + ".extensions." + key);
 }
 
 int SceneBuilder::texture(const tinygltf::NormalTextureInfo& info, const std::string& at) {

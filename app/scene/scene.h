@@ -63,11 +63,44 @@ struct Material {
   glm::vec3 emission{0.0f};           // emissiveFactor * emissive_strength: emitted radiance (linear)
   int emissiveTexture = -1;           // index into Scene::textures, -1 = none
   bool doubleSided = false;
+  // Textures of the factors above (indices into Scene::textures, -1 = none; linear unless said):
+  // KHR_materials_transmission's transmissionTexture (R multiplies transmission) and
+  // KHR_materials_specular's specularTexture (A multiplies specularFactor) and specularColorTexture
+  // (RGB, sRGB, multiplies specularColorFactor). With either specular texture the GPU rebuilds F0 and
+  // F90 per hit from the factors as written: specularColorFactor and specularFactor.
+  int transmissionTexture = -1;
+  int specularTexture = -1;
+  int specularColorTexture = -1;
+  glm::vec3 specularColorFactor{1.0f};
+  float specularFactor = 1.0f;
+  // KHR_materials_clearcoat: a GGX reflection of index 1.5 layered over the whole material, weighted
+  // by clearcoat x its Schlick Fresnel (docs/materials.md). clearcoat = 0: no layer.
+  float clearcoat = 0.0f;                // clearcoatFactor in [0, 1] (x clearcoatTexture R)
+  float clearcoatRoughness = 0.0f;       // clearcoatRoughnessFactor (x clearcoatRoughnessTexture G); GGX alpha = r^2
+  int clearcoatTexture = -1;
+  int clearcoatRoughnessTexture = -1;
+  int clearcoatNormalTexture = -1;       // the layer's own normal map (none: the interpolated normal)
+  float clearcoatNormalScale = 1.0f;
+  // KHR_materials_sheen: the Charlie sheen layered over the base (under the coat). Black: no layer.
+  glm::vec3 sheenColor{0.0f};            // sheenColorFactor (linear; x sheenColorTexture RGB, sRGB)
+  float sheenRoughness = 0.0f;           // sheenRoughnessFactor (x sheenRoughnessTexture A)
+  int sheenColorTexture = -1;
+  int sheenRoughnessTexture = -1;
+  // KHR_materials_unlit: the loader has made the material an emitter of its base colour that reflects
+  // nothing (emission = base colour factor, emissiveTexture = baseColorTexture, base colour black).
+  bool unlit = false;
 
   bool isEmissive() const { return emission.r > 0.0f || emission.g > 0.0f || emission.b > 0.0f; }
+  bool hasClearcoat() const { return clearcoat > 0.0f; }
+  bool hasSheen() const { return sheenColor.r > 0.0f || sheenColor.g > 0.0f || sheenColor.b > 0.0f; }
+  // Whether a texture scales transmission or the specular layer (CAUSTICA_FACTOR_TEXTURES).
+  bool hasFactorTextures() const { return transmissionTexture >= 0 || specularTexture >= 0 || specularColorTexture >= 0; }
   // Whether any texture of the material is read (then its triangles need texture coordinates).
   bool readsTextures() const {
-    return baseColorTexture >= 0 || emissiveTexture >= 0 || metallicRoughnessTexture >= 0 || normalTexture >= 0;
+    return baseColorTexture >= 0 || emissiveTexture >= 0 || metallicRoughnessTexture >= 0 || normalTexture >= 0 ||
+           hasFactorTextures() ||
+           (hasClearcoat() && (clearcoatTexture >= 0 || clearcoatRoughnessTexture >= 0 || clearcoatNormalTexture >= 0)) ||
+           (hasSheen() && (sheenColorTexture >= 0 || sheenRoughnessTexture >= 0));
   }
 };
 

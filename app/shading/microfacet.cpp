@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shading/layers.h"
 #include "shading/sampling.h"
 #include "util/math_constants.h"
 
@@ -98,6 +99,7 @@ glm::vec3 bsdfEval(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi) {
   }
   if (wi.z <= 0.0f) return glm::vec3(0.0f);
   if (b.lobe == kLobeDiffuse) return b.color * kInvPi;
+  if (b.lobe == kLobeSheen) return sheenEval(b.color, b.alpha, wo, wi);
   glm::vec3 h = wo + wi;
   float len = glm::length(h);
   if (!(len > 0.0f)) return glm::vec3(0.0f);
@@ -126,6 +128,7 @@ float bsdfPdf(const Bsdf& b, const glm::vec3& wo, const glm::vec3& wi) {
   }
   if (wi.z <= 0.0f) return 0.0f;
   if (b.lobe == kLobeDiffuse) return wi.z * kInvPi;
+  if (b.lobe == kLobeSheen) return 0.5f * kInvPi;  // sampleUniformHemisphere
   glm::vec3 h = wo + wi;
   float len = glm::length(h);
   if (!(len > 0.0f)) return 0.0f;
@@ -157,6 +160,8 @@ bool bsdfSample(const Bsdf& b, const glm::vec3& wo, const glm::vec3& u, BsdfSamp
     }
   } else if (b.lobe == kLobeDiffuse) {
     s.wi = sampleCosineHemisphere(uDir);
+  } else if (b.lobe == kLobeSheen) {
+    s.wi = sampleUniformHemisphere(uDir);
   } else if (b.lobe == kLobeConductor || u.x < plasticSpecularProbability(b, wo)) {
     s.wi = reflectAbout(wo, ggxSampleVisibleNormal(wo, b.alpha, uDir));
     if (s.wi.z <= 0.0f) return false;

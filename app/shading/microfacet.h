@@ -17,6 +17,7 @@ constexpr std::uint32_t kLobeGlass = 2;        // smooth dielectric: delta refle
 constexpr std::uint32_t kLobeConductor = 3;    // rough metal: GGX with Schlick Fresnel, F0 = C
 constexpr std::uint32_t kLobePlastic = 4;      // GGX dielectric specular over Lambertian (glTF fresnel_mix)
 constexpr std::uint32_t kLobeRoughGlass = 5;   // rough dielectric: GGX reflection + refraction (Walter 2007)
+constexpr std::uint32_t kLobeSheen = 6;        // Charlie sheen scaled to albedo C (shading/layers.h)
 
 // glTF roughness r gives GGX alpha = r^2. Below this alpha a metal or glass lobe is the exact delta lobe.
 constexpr float kDeltaAlpha = 1.0e-3f;
@@ -26,8 +27,8 @@ constexpr float kMinPlasticAlpha = 1.0e-3f;
 // One lobe with its parameters at a shading point.
 struct Bsdf {
   std::uint32_t lobe = kLobeDiffuse;
-  glm::vec3 color{1.0f};  // base colour C: diffuse albedo, conductor F0, transmission tint
-  float alpha = 1.0f;     // GGX alpha (roughness^2)
+  glm::vec3 color{1.0f};  // base colour C: diffuse albedo, conductor F0, transmission tint; sheen: its albedo
+  float alpha = 1.0f;     // GGX alpha (roughness^2); sheen: sheen roughness^2
   float eta = 1.5f;       // dielectric: n on the wi side of a refraction / n on the wo side
   glm::vec3 f0{0.04f};    // plastic: specular reflectance at normal incidence (KHR_materials_specular)
   float f90 = 1.0f;       // plastic: specular reflectance at grazing incidence (specularFactor)

@@ -16,15 +16,20 @@ layout(binding = CAUSTICA_TEXUNIT_TRI_SHADE) uniform usamplerBuffer triShadeTexe
 #endif
 // the materials, and the texture block (TexInfo records of kTexInfoWords words first, then the RGBA8
 // texels; TexInfo.offset counts from word 0) as words and as records; the light-tree nodes: light_tree.glsl.
-layout(binding = CAUSTICA_TEXUNIT_MATERIALS) uniform usamplerBuffer materialTexels;  // 7 texels per Material
+layout(binding = CAUSTICA_TEXUNIT_MATERIALS) uniform usamplerBuffer materialTexels;  // kMaterialTexels per Material
 layout(binding = CAUSTICA_TEXUNIT_TEXELS) uniform usamplerBuffer texelWords;         // r32ui: one word per texel
 layout(binding = CAUSTICA_TEXUNIT_TEX_INFO) uniform usamplerBuffer texInfoTexels;    // 3 texels per TexInfo
 layout(std430, binding = CAUSTICA_BINDING_COUNTERS) buffer CounterBuffer { Counters counters; };
 
 layout(std140, binding = CAUSTICA_BINDING_FRAME) uniform FrameBlock { FrameParams frame; };
-// Material record i (gpu_layout.h), 7 RGBA32UI texels.
+// The layer texels of a Material are read only where a layer or a factor texture may be used.
+#if defined(CAUSTICA_CLEARCOAT) || defined(CAUSTICA_SHEEN) || defined(CAUSTICA_FACTOR_TEXTURES)
+#define CAUSTICA_MATERIAL_LAYERS
+#endif
+
+// Material record i (gpu_layout.h), kMaterialTexels RGBA32UI texels (the last five: CAUSTICA_MATERIAL_LAYERS).
 Material materialAt(uint i) {
-  int b = int(7u * i);
+  int b = int(kMaterialTexels * i);
   Material m;
   m.baseColor = uintBitsToFloat(texelFetch(materialTexels, b));
   m.emission = uintBitsToFloat(texelFetch(materialTexels, b + 1));
@@ -33,6 +38,19 @@ Material materialAt(uint i) {
   m.tex = texelFetch(materialTexels, b + 4);
   m.specular = uintBitsToFloat(texelFetch(materialTexels, b + 5));
   m.tex2 = texelFetch(materialTexels, b + 6);
+#ifdef CAUSTICA_MATERIAL_LAYERS
+  m.coat = uintBitsToFloat(texelFetch(materialTexels, b + 7));
+  m.sheen = uintBitsToFloat(texelFetch(materialTexels, b + 8));
+  m.tex3 = texelFetch(materialTexels, b + 9);
+  m.tex4 = texelFetch(materialTexels, b + 10);
+  m.specularBase = uintBitsToFloat(texelFetch(materialTexels, b + 11));
+#else
+  m.coat = vec4(0.0);
+  m.sheen = vec4(0.0);
+  m.tex3 = uvec4(kInvalidIndex);
+  m.tex4 = uvec4(kInvalidIndex);
+  m.specularBase = vec4(0.0);
+#endif
   return m;
 }
 

@@ -71,7 +71,22 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
 #endif
   uv = (1.0 - b.x - b.y) * t0 + b.x * t1 + b.y * t2;
 #endif
-  ls.le = materialEmission(m, uv);
+  // As a path that hits it sees it: under its clear coat, and present with its opacity (path_scatter.glsl's
+  // passThrough), so that both estimators weigh the same emission.
+  ls.le = materialEmissionSeen(m, uv, dot(ls.n, normalize(p - ls.p)));
+#ifdef CAUSTICA_OPACITY
+  vec4 color = vec4(1.0);  // the vertex colour, whose alpha is part of the opacity (surface.glsl)
+#if defined(CAUSTICA_VERTEX_COLORS) && defined(CAUSTICA_TRISHADE_COLORS)
+  vec4 c0, c1, c2;
+#ifdef CAUSTICA_INSTANCED
+  instanceColors(tri, xf, c0, c1, c2);
+#else
+  triColors(tri, c0, c1, c2);
+#endif
+  color = (1.0 - b.x - b.y) * c0 + b.x * c1 + b.y * c2;
+#endif
+  ls.le *= materialBaseColor(m, uv, color).a;
+#endif
   ls.pdfArea = pmf / (0.5 * len);
   ls.twoSided = (m.tex.z & kMatDoubleSided) != 0u;
   return ls.pdfArea > 0.0;

@@ -1,6 +1,7 @@
 // materials.glsl — the material contract (docs/materials.md) on the GPU: base colour, opacity,
-// metallic and roughness, emission, normal maps, lobe choice (metal weight m, glass (1-m)t, diffuse
-// (1-m)(1-t); each a delta lobe or a GGX lobe from microfacet.glsl) and the smooth dielectric.
+// metallic and roughness, transmission, the specular layer, emission, normal maps, the clear-coat and
+// sheen layers' parameters (layers.glsl), lobe choice (metal weight m, glass (1-m)t, diffuse (1-m)(1-t);
+// each a delta lobe or a GGX lobe from microfacet.glsl) and the smooth dielectric.
 
 // Linear base colour (rgb) and opacity (a) at uv, for a hit whose vertex colour (COLOR_0) is
 // vertexColor: factor x texture x vertex colour (glTF 3.9.2); alpha likewise in BLEND and MASK only.
@@ -37,6 +38,58 @@ vec2 materialMetalRough(Material m, vec2 uv) {
   return mr;
 }
 
+// Transmission (the glass weight before metal) at uv: the factor times transmissionTexture's R (linear).
+float materialTransmission(Material m, vec2 uv) {
+  float t = m.params.z;
+#ifdef CAUSTICA_FACTOR_TEXTURES
+  if (m.tex4.w != kInvalidIndex) t *= sampleDataTexture(m.tex4.w, uv).r;
+#endif
+  return t;
+}
+
+// The specular layer's F0 (rgb) and F90 (w) at uv (KHR_materials_specular): with its textures,
+// F0 = min(((ior - 1) / (ior + 1))^2 specularColorFactor x specularColorTexture, 1) x specularFactor x
+// specularTexture.a and F90 = specularFactor x specularTexture.a; else the factors' (packed).
+vec4 materialSpecular(Material m, vec2 uv) {
+  vec4 s = m.specular;
+#ifdef CAUSTICA_FACTOR_TEXTURES
+  if (m.tex4.y != kInvalidIndex || m.tex4.z != kInvalidIndex) {
+    vec3 tint = m.specularBase.rgb;
+    float factor = m.specularBase.w;
+    if (m.tex4.z != kInvalidIndex) tint *= sampleTexture(m.tex4.z, uv).rgb;
+    if (m.tex4.y != kInvalidIndex) factor *= sampleDataTexture(m.tex4.y, uv).a;
+    s = vec4(min(tint, vec3(1.0)) * factor, factor);
+  }
+#endif
+  return s;
+}
+
+#ifdef CAUSTICA_CLEARCOAT
+// Clear-coat weight (x) and roughness (y) at uv: the factors times clearcoatTexture's R and
+// clearcoatRoughnessTexture's G (linear).
+vec2 materialCoat(Material m, vec2 uv) {
+  vec2 c = m.coat.xy;
+#ifdef CAUSTICA_TEXTURES
+  if (m.tex3.x != kInvalidIndex) c.x *= sampleDataTexture(m.tex3.x, uv).r;
+  if (m.tex3.y != kInvalidIndex) c.y *= sampleDataTexture(m.tex3.y, uv).g;
+#endif
+  return c;
+}
+#endif
+
+#ifdef CAUSTICA_SHEEN
+// Sheen colour (rgb, linear) and roughness (w) at uv: the factors times sheenColorTexture's RGB (sRGB)
+// and sheenRoughnessTexture's A.
+vec4 materialSheen(Material m, vec2 uv) {
+  vec4 s = m.sheen;
+#ifdef CAUSTICA_TEXTURES
+  if (m.tex3.w != kInvalidIndex) s.rgb *= sampleTexture(m.tex3.w, uv).rgb;
+  if (m.tex4.x != kInvalidIndex) s.w *= sampleDataTexture(m.tex4.x, uv).a;
+#endif
+  return s;
+}
+#endif
+
 #ifdef CAUSTICA_TEXTURES
 // The triangle's tangent frame: t its dp/du made orthogonal to n, b = cross(n, t) turned towards -v;
 // false where the texcoords or dp/du are degenerate.
@@ -57,16 +110,16 @@ bool tangentFromTriangle(vec3 n, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, 
 }
 #endif
 
-// The shading normal after the material's normal map (tangent space, glTF: +x along the tangent, +y
-// along the bitangent). n: interpolated unit normal on the front side; tangent: the file's TANGENT
-// interpolated at the hit (xyz; w the bitangent's sign, glTF: bitangent = cross(n, tangent) w), or w = 0
-// where the mesh has none: then the tangent is the triangle's dp/du (from p0..p2 and uv0..uv2) and
-// the bitangent points towards -v (up in the image), the same frame for an unmirrored map. Either
-// tangent is made orthogonal to n. Returns n where the map or the frame is unusable.
-vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2,
-                    vec4 tangent) {
+// The shading normal after normal map `tex` (tangent space, glTF: +x along the tangent, +y along the
+// bitangent; its x and y times `scale`). n: interpolated unit normal on the front side; tangent: the
+// file's TANGENT interpolated at the hit (xyz; w the bitangent's sign, glTF: bitangent = cross(n,
+// tangent) w), or w = 0 where the mesh has none: then the tangent is the triangle's dp/du (from p0..p2
+// and uv0..uv2) and the bitangent points towards -v (up in the image), the same frame for an unmirrored
+// map. Either tangent is made orthogonal to n. Returns n where the map or the frame is unusable.
+vec3 applyNormalMapTexture(uint tex, float scale, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1,
+                           vec2 uv2, vec4 tangent) {
 #ifdef CAUSTICA_TEXTURES
-  if (m.tex2.y == kInvalidIndex) return n;
+  if (tex == kInvalidIndex) return n;
   vec3 t, b;
   if (tangent.w != 0.0) {
     t = tangent.xyz - n * dot(n, tangent.xyz);
@@ -77,8 +130,7 @@ vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2
   } else if (!tangentFromTriangle(n, p0, p1, p2, uv0, uv1, uv2, t, b)) {
     return n;
   }
-  vec3 c = sampleDataTexture(m.tex2.y, uv).xyz * 2.0 - 1.0;
-  float scale = uintBitsToFloat(m.tex2.z);
+  vec3 c = sampleDataTexture(tex, uv).xyz * 2.0 - 1.0;
   c.xy *= scale;
   vec3 mapped = c.x * t + c.y * b + c.z * n;
   float len = length(mapped);
@@ -88,11 +140,28 @@ vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2
 #endif
 }
 
+// The material's normal map (normalTexture) applied to n (applyNormalMapTexture).
+vec3 applyNormalMap(Material m, vec3 n, vec2 uv, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2,
+                    vec4 tangent) {
+  return applyNormalMapTexture(m.tex2.y, uintBitsToFloat(m.tex2.z), n, uv, p0, p1, p2, uv0, uv1, uv2, tangent);
+}
+
 // Emitted radiance at uv (front face only unless double-sided; the caller checks the side).
 vec3 materialEmission(Material m, vec2 uv) {
   vec3 e = m.emission.rgb;
 #ifdef CAUSTICA_TEXTURES
   if (m.tex.y != kInvalidIndex) e *= sampleTexture(m.tex.y, uv).rgb;
+#endif
+  return e;
+}
+
+// Emitted radiance at uv leaving at |cos theta| to the geometric normal, as a path or light sampling
+// sees it: under a clear coat darkened by the coat's weight (KHR_materials_clearcoat: emission x
+// (1 - clearcoat x Fresnel); the Fresnel is taken to the geometric normal, the one light sampling knows).
+vec3 materialEmissionSeen(Material m, vec2 uv, float cosTheta) {
+  vec3 e = materialEmission(m, uv);
+#ifdef CAUSTICA_CLEARCOAT
+  e *= 1.0 - materialCoat(m, uv).x * coatFresnel(cosTheta);
 #endif
   return e;
 }
@@ -105,13 +174,12 @@ bool isEmissive(Material m) { return maxComponent(m.emission.rgb) > 0.0; }
 // layer (F90 > 0) the plastic lobe; otherwise the delta lobes and the Lambertian lobe as before.
 // (Glass of ior 1 stays the delta lobe: it passes light straight through, and the generalised half
 // vector of rough refraction does not exist there.)
-uint chooseLobe(Material m, float metal, float roughness, float u) {
-  float trans = 0.0;
+uint chooseLobe(Material m, float metal, float roughness, float trans, float u) {
 #ifndef CAUSTICA_MIRROR
   metal = 0.0;
 #endif
-#ifdef CAUSTICA_GLASS
-  trans = m.params.z;
+#ifndef CAUSTICA_GLASS
+  trans = 0.0;
 #endif
   uint lobe = kLobeDiffuse;
   if (u < metal) lobe = kLobeMirror;
@@ -125,17 +193,18 @@ uint chooseLobe(Material m, float metal, float roughness, float u) {
   return lobe;
 }
 
-// The GGX lobe `lobe` of material m at a hit: base colour C, roughness, eta (rough glass: n beyond
-// the surface / n on the ray's side).
-Bsdf makeBsdf(Material m, uint lobe, vec3 color, float roughness, float eta) {
+// The non-delta lobe `lobe` at a hit: colour C (base colour; the sheen's tint; white for the coat),
+// roughness (GGX, or the sheen's), eta (rough glass: n beyond the surface / n on the ray's side) and
+// the specular layer's F0 (rgb) and F90 (w) (materialSpecular).
+Bsdf makeBsdf(uint lobe, vec3 color, float roughness, float eta, vec4 specular) {
   Bsdf b;
   b.lobe = lobe;
   b.color = color;
   b.alpha = roughness * roughness;
   if (lobe == kLobePlastic) b.alpha = max(b.alpha, kMinPlasticAlpha);
   b.eta = eta;
-  b.f0 = m.specular.rgb;
-  b.f90 = m.specular.w;
+  b.f0 = specular.rgb;
+  b.f90 = specular.w;
   return b;
 }
 

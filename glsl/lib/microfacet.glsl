@@ -3,6 +3,9 @@
 // plastic (glTF fresnel_mix) and rough glass (Walter et al. 2007). Twins in app/shading/microfacet.cpp.
 // Directions are in the local shading frame (unit, normal = +z); wo points back along the path, wi
 // towards the light. Needs sampling.glsl (PI, luminance, fresnelDielectric, refractDir, sampleCosineHemisphere).
+// The sheen lobe's own functions are in layers.glsl.
+
+#include "layers.glsl"
 
 const uint kLobeDiffuse = 0u;     // Lambertian, C / pi (sampled in path_scatter.glsl: caustic casters)
 const uint kLobeMirror = 1u;      // smooth metal: delta reflection times C
@@ -10,12 +13,18 @@ const uint kLobeGlass = 2u;       // smooth dielectric: delta reflection / refra
 const uint kLobeConductor = 3u;   // rough metal: GGX, Schlick Fresnel with F0 = C
 const uint kLobePlastic = 4u;     // GGX dielectric specular over Lambertian
 const uint kLobeRoughGlass = 5u;  // rough dielectric: GGX reflection and refraction
+const uint kLobeSheen = 6u;       // the Charlie sheen (KHR_materials_sheen), scaled to albedo C (layers.glsl)
 
 // The glossy lobes (from kLobeConductor up: non-delta and not Lambertian) are compiled in when a
 // feature that makes one is (the shader-feature table): the bounce loop's glossy branches
-// (path_scatter.glsl) test this, so a new glossy lobe adds its define here, not there.
-#if defined(CAUSTICA_GGX)
+// (path_scatter.glsl) test this, so a new glossy lobe adds its define here, not there. The clear coat
+// is a white metal lobe (kLobeMirror when smooth, kLobeConductor when rough) on the coat's normal.
+#if defined(CAUSTICA_GGX) || defined(CAUSTICA_CLEARCOAT) || defined(CAUSTICA_SHEEN)
 #define CAUSTICA_GLOSSY_LOBES
+#endif
+// The mirror and conductor lobes: metals and the clear coat.
+#if defined(CAUSTICA_MIRROR) || defined(CAUSTICA_CLEARCOAT)
+#define CAUSTICA_MIRROR_LOBE
 #endif
 
 const float kDeltaAlpha = 1.0e-3;       // below this GGX alpha a metal or glass lobe is the delta lobe
@@ -30,17 +39,22 @@ const float kMinPlasticAlpha = 1.0e-3;  // the plastic lobe's alpha is at least 
 #else
 #define CAUSTICA_IS_ROUGH_GLASS(l) ((l) == kLobeRoughGlass)
 #endif
-#if defined(CAUSTICA_GGX) && !defined(CAUSTICA_MIRROR)
+#if defined(CAUSTICA_GGX) && !defined(CAUSTICA_MIRROR_LOBE)
 #define CAUSTICA_IS_CONDUCTOR(l) false
 #else
 #define CAUSTICA_IS_CONDUCTOR(l) ((l) == kLobeConductor)
+#endif
+#if defined(CAUSTICA_GGX) && !defined(CAUSTICA_SHEEN)
+#define CAUSTICA_IS_SHEEN(l) false
+#else
+#define CAUSTICA_IS_SHEEN(l) ((l) == kLobeSheen)
 #endif
 
 // One lobe with its parameters at a shading point.
 struct Bsdf {
   uint lobe;
-  vec3 color;  // base colour C: diffuse albedo, conductor F0, transmission tint
-  float alpha; // GGX alpha = roughness^2
+  vec3 color;  // base colour C: diffuse albedo, conductor F0, transmission tint; sheen: its albedo
+  float alpha; // GGX alpha = roughness^2 (sheen: sheen roughness^2)
   float eta;   // dielectric: n on the wi side of a refraction / n on the wo side
   vec3 f0;     // plastic: specular reflectance at normal incidence
   float f90;   // plastic: specular reflectance at grazing incidence
@@ -132,6 +146,10 @@ float bsdfEvalPdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f) {
     f = b.color * INV_PI;
     return wi.z * INV_PI;
   }
+  if (CAUSTICA_IS_SHEEN(b.lobe)) {
+    f = sheenEval(b.color, b.alpha, wo, wi);
+    return 0.5 * INV_PI;  // sampleUniformHemisphere
+  }
   bool refl = wi.z > 0.0;  // always outside rough glass
   float etap = refl ? 1.0 : b.eta;
   vec3 m = wi * etap + wo;  // generalizedHalf's arithmetic; the reflection half vector when etap = 1
@@ -197,12 +215,14 @@ bool bsdfSample(Bsdf b, vec3 wo, vec3 u, out BsdfSample s) {
   vec2 uDir = u.yz;
   // One call of each direction sampler and of reflectAbout for every lobe (llvmpipe runs every branch):
   // a visible normal for rough glass, rough metal and plastic's specular part, a cosine direction for
-  // the diffuse lobe and plastic's diffuse part.
+  // the diffuse lobe and plastic's diffuse part, a uniform one for the sheen.
   bool roughGlass = CAUSTICA_IS_ROUGH_GLASS(b.lobe);
+  bool sheen = CAUSTICA_IS_SHEEN(b.lobe);
   vec3 wm = ggxSampleVisibleNormal(wo, b.alpha, uDir);
   float f = fresnelDielectric(dot(wo, wm), b.eta);  // rough glass only
   bool specular = roughGlass ? u.x < f
-                             : b.lobe != kLobeDiffuse && (CAUSTICA_IS_CONDUCTOR(b.lobe) || u.x < plasticSpecularProbability(b, wo));
+                             : b.lobe != kLobeDiffuse && !sheen &&
+                                   (CAUSTICA_IS_CONDUCTOR(b.lobe) || u.x < plasticSpecularProbability(b, wo));
   if (roughGlass && !specular) {
     if (!refractDir(-wo, wm, 1.0 / b.eta, s.wi) || s.wi.z >= 0.0) return false;
     s.transmitted = true;
@@ -210,7 +230,7 @@ bool bsdfSample(Bsdf b, vec3 wo, vec3 u, out BsdfSample s) {
     s.wi = reflectAbout(wo, wm);
     if (s.wi.z <= 0.0) return false;
   } else {
-    s.wi = sampleCosineHemisphere(uDir);
+    s.wi = sheen ? sampleUniformHemisphere(uDir) : sampleCosineHemisphere(uDir);
   }
   vec3 fv;
   s.pdf = bsdfEvalPdf(b, wo, s.wi, fv);

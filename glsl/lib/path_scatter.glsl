@@ -1,7 +1,8 @@
-// path_scatter.glsl — how a path tracer's path leaves a surface: alpha pass-through, the lobe chosen
-// there, its vertex for light sampling, and its direction (Lambertian with the caster mixture, GGX,
-// mirror, smooth glass) with the throughput it costs. Needs path_state.glsl, surface.glsl,
-// materials.glsl, vertex.glsl, spectral.glsl (casters.glsl with CAUSTICA_CASTERS).
+// path_scatter.glsl — how a path tracer's path leaves a surface: alpha pass-through, the layer and lobe
+// chosen there (clear coat, sheen, or the base material's lobes), its vertex for light sampling, and
+// its direction (Lambertian with the caster mixture, GGX, sheen, mirror, smooth glass) with the
+// throughput it costs. Needs path_state.glsl, surface.glsl, materials.glsl, vertex.glsl, spectral.glsl
+// (casters.glsl with CAUSTICA_CASTERS).
 //
 // llvmpipe runs both sides of every branch (masked) for all 8 lanes of a SIMD group, and a loop's
 // body at least once, so each call site of a light estimate or a traversal costs on every bounce
@@ -44,10 +45,11 @@ float glassIor(Material m, inout float lambda, inout vec3 filt, inout uvec4 rng)
 // The lobe a path scatters by at a surface, and what its sampling needs.
 struct BounceLobe {
   uint lobe;        // kLobe* (microfacet.glsl), chosen with probability equal to its weight
-  vec3 color;       // base colour at the hit
-  float roughness;  // material roughness at the hit
+  vec3 color;       // base colour at the hit (the coat: white; the sheen: its colour / its largest component)
+  float roughness;  // material roughness at the hit (the coat's or the sheen's for those lobes)
   float eta;        // glass lobes: n beyond the surface / n on the ray's side; 1 for the others
   vec3 sigmaBelow;  // absorption coefficient of the medium beyond the surface (where refracted light goes)
+  vec4 specular;    // the specular layer's F0 (rgb) and F90 (w) at the hit (plastic)
 };
 
 bool isDiffuseLobe(BounceLobe l) { return l.lobe == kLobeDiffuse; }
@@ -59,16 +61,57 @@ bool isGlossyLobe(BounceLobe l) {  // the glossy lobes: rough metal, plastic, ro
 #endif
 }
 
-// Chooses the lobe at surface sf with base colour `color` (one random number). Both glass lobes take
-// the wavelength's index of refraction here (one glassIor call for the two lobes).
-BounceLobe chooseBounceLobe(inout PathState s, Surface sf, vec3 color) {
+// Chooses the lobe at surface sf with base colour `color` (one random number): the clear coat, else the
+// sheen, else one of the base material's lobes (layers.glsl: the coat's pick is weighed into s.beta; the
+// number is rescaled past each layer, so without layers the base sees it unchanged). The coat's
+// lobe (a white metal lobe, delta or GGX by the coat's roughness) works about the coat normal: sf.ns
+// becomes sf.nc, so that its vertex, its light sampling and the path's next MIS all use the coat's
+// frame. Both glass lobes take the wavelength's index of refraction here (one glassIor call for both).
+BounceLobe chooseBounceLobe(inout PathState s, inout Surface sf, vec3 color) {
   BounceLobe l;
+  float u = rand01(s.rng);
   vec2 metalRough = materialMetalRough(sf.m, sf.uv);
-  l.lobe = chooseLobe(sf.m, metalRough.x, metalRough.y, rand01(s.rng));
+  float trans = materialTransmission(sf.m, sf.uv);
   l.color = color;
   l.roughness = metalRough.y;
   l.eta = 1.0;
   l.sigmaBelow = s.sigma;
+  l.specular = materialSpecular(sf.m, sf.uv);
+#if defined(CAUSTICA_CLEARCOAT) || defined(CAUSTICA_SHEEN)
+  vec2 coat = vec2(0.0);  // weight, roughness
+  float cosCoat = 1.0;
+  vec4 sheen = vec4(0.0);  // colour, roughness
+#ifdef CAUSTICA_CLEARCOAT
+  coat = materialCoat(sf.m, sf.uv);
+  cosCoat = -dot(s.dir, sf.nc);
+#endif
+#ifdef CAUSTICA_SHEEN
+  sheen = materialSheen(sf.m, sf.uv);
+#endif
+  LayerWeights w = layerWeights(coat.x, cosCoat, sheen.rgb, sheen.w, -dot(s.dir, sf.ns), luminance(color));
+  bool takeCoat = u < w.coatPick;
+  // The pick weighed by its weight over its probability (exactly 1 without a coat).
+  s.beta *= takeCoat ? w.coat / w.coatPick : (1.0 - w.coat) / (1.0 - w.coatPick);
+  u = w.coatPick < 1.0 ? max(u - w.coatPick, 0.0) / (1.0 - w.coatPick) : 0.0;
+  bool takeSheen = !takeCoat && u < w.sheen;
+  u = w.sheen < 1.0 ? max(u - w.sheen, 0.0) / (1.0 - w.sheen) : 0.0;
+#endif
+  l.lobe = chooseLobe(sf.m, metalRough.x, metalRough.y, trans, u);
+#ifdef CAUSTICA_SHEEN
+  if (takeSheen) {
+    l.lobe = kLobeSheen;
+    l.color = sheen.rgb / maxComponent(sheen.rgb);
+    l.roughness = sheenRoughnessClamped(sheen.w);
+  }
+#endif
+#ifdef CAUSTICA_CLEARCOAT
+  if (takeCoat) {
+    l.lobe = coat.y * coat.y >= kDeltaAlpha ? kLobeConductor : kLobeMirror;
+    l.color = vec3(1.0);
+    l.roughness = coat.y;
+    sf.ns = sf.nc;
+  }
+#endif
 #ifdef CAUSTICA_GLASS
   if (l.lobe == kLobeGlass || l.lobe == kLobeRoughGlass) {
     float ior = glassIor(sf.m, s.lambda, s.filt, s.rng);
@@ -108,7 +151,7 @@ Vertex lobeVertex(PathState s, Surface sf, BounceLobe l) {
   const uint vertexLobe = kLobeDiffuse;
 #endif
   bool diffuse = isDiffuseLobe(l);
-  return makeVertex(makeBsdf(sf.m, vertexLobe, l.color, diffuse ? 1.0 : l.roughness, l.eta), sf.p, sf.pError,
+  return makeVertex(makeBsdf(vertexLobe, l.color, diffuse ? 1.0 : l.roughness, l.eta, l.specular), sf.p, sf.pError,
                     sf.ng, sf.ns, s.dir, s.sigma, l.sigmaBelow);
 }
 
@@ -151,9 +194,9 @@ bool scatterNonDelta(inout PathState s, Surface sf, Vertex v, BounceLobe l, inou
   return true;
 }
 
-// A delta lobe's direction (mirror, smooth glass) and throughput.
+// A delta lobe's direction (mirror, smooth clear coat, smooth glass) and throughput.
 void scatterDelta(inout PathState s, Surface sf, BounceLobe l, out vec3 newDir) {
-#ifdef CAUSTICA_MIRROR
+#ifdef CAUSTICA_MIRROR_LOBE
   if (l.lobe == kLobeMirror) {
     newDir = reflect(s.dir, sf.ns);
     if (dot(newDir, sf.ng) <= 0.0) newDir = reflect(s.dir, sf.ng);
@@ -162,7 +205,7 @@ void scatterDelta(inout PathState s, Surface sf, BounceLobe l, out vec3 newDir) 
   }
 #endif
 #ifdef CAUSTICA_GLASS
-#ifdef CAUSTICA_MIRROR
+#ifdef CAUSTICA_MIRROR_LOBE
   else
 #endif
   {

@@ -9,6 +9,9 @@ struct Surface {
   bool front;    // the ray arrived on the front face
   vec3 ng;       // unit geometric normal on the side the ray came from
   vec3 ns;       // unit shading normal (interpolated, normal-mapped) on that side
+#ifdef CAUSTICA_CLEARCOAT
+  vec3 nc;       // unit normal of the clear coat on that side: interpolated, with the coat's own normal map
+#endif
   vec2 uv;       // texcoords
   vec4 color;    // vertex colour (COLOR_0, linear RGBA; white without CAUSTICA_VERTEX_COLORS)
   Material m;
@@ -84,9 +87,9 @@ bool surfaceOn(Hit hit, HitTriangle h, vec3 dir, bool normalMapped, out Surface 
 #endif
   sf.m = materialAt(floatBitsToUint(g.v0.w));
 #ifdef CAUSTICA_TEXTURES
-  if (normalMapped) {
-    vec4 tangent = vec4(0.0);  // none: the normal map takes the triangle's dp/du
+  vec4 tangent = vec4(0.0);  // none: a normal map takes the triangle's dp/du
 #ifdef CAUSTICA_TRISHADE_TANGENTS
+  if (normalMapped) {
     vec4 tt0, tt1, tt2;
 #ifdef CAUSTICA_INSTANCED
     instanceTangents(hit.tri, h.xf, tt0, tt1, tt2);
@@ -95,9 +98,20 @@ bool surfaceOn(Hit hit, HitTriangle h, vec3 dir, bool normalMapped, out Surface 
 #endif
     // The file's TANGENT where every corner has one (w: the first corner's sign).
     if (tt0.w != 0.0 && tt1.w != 0.0 && tt2.w != 0.0) tangent = vec4(b0 * tt0.xyz + hit.u * tt1.xyz + hit.v * tt2.xyz, tt0.w);
-#endif
-    ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2, tangent);
   }
+#endif
+#endif
+#ifdef CAUSTICA_CLEARCOAT
+  vec3 nc = ns;  // KHR_materials_clearcoat: the base's normal map does not apply to the coat
+#ifdef CAUSTICA_TEXTURES
+  if (normalMapped)
+    nc = applyNormalMapTexture(sf.m.tex3.z, sf.m.coat.z, nc, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2,
+                               tangent);
+#endif
+  sf.nc = sf.front ? nc : -nc;
+#endif
+#ifdef CAUSTICA_TEXTURES
+  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2, tangent);
 #endif
   sf.ns = sf.front ? ns : -ns;
   return true;

@@ -40,7 +40,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_TEXUNIT_BVH_WIDE 6    // texture unit: buffer texture (rgba32ui) over the BvhWideNode buffer, 7 texels per node
 // The shading reads go through buffer textures too (app/gpu/shading_textures.*): on llvmpipe a texelFetch
 // is a vector gather, an SSBO load a loop over the SIMD lanes (docs/architecture.md, "Writing shaders for llvmpipe").
-#define CAUSTICA_TEXUNIT_MATERIALS 4   // texture unit: buffer texture (rgba32ui) over the materials buffer, 7 texels per Material
+#define CAUSTICA_TEXUNIT_MATERIALS 4   // texture unit: buffer texture (rgba32ui) over the materials buffer, 12 texels per Material
 #define CAUSTICA_TEXUNIT_LIGHT_NODES 5 // texture unit: buffer texture (rgba32ui) over the light-tree buffer, 4 texels per LightNode
 #define CAUSTICA_TEXUNIT_TEXELS 7      // texture unit: buffer texture (r32ui) over the texel buffer, one word per texel
 #define CAUSTICA_TEXUNIT_TEX_INFO 8    // texture unit: buffer texture (rgba32ui) over the same buffer, 3 texels per TexInfo
@@ -200,7 +200,9 @@ CAUSTICA_CONST uint kTriShadeColorWords = 6u;
 CAUSTICA_CONST uint kTriShadeTangentWords = 3u;
 CAUSTICA_CONST uint kOctZeroNormal = 0x80008000u;  // snorm -32768 twice: never produced by octEncode
 
-// Material after the glTF material contract (docs/materials.md), 112 bytes.
+// Material after the glTF material contract (docs/materials.md), 192 bytes: the first seven texels are
+// read at every hit; the last five only by shaders with a layer (clear coat, sheen) or the specular and
+// transmission textures (materialAt, bindings.glsl).
 struct Material {
   vec4 baseColor;     // rgb: linear base colour factor; a: opacity (1 = opaque)
   vec4 emission;      // rgb: emitted radiance (linear, W sr^-1 m^-2 relative units); w: unused
@@ -210,7 +212,17 @@ struct Material {
   vec4 specular;      // rgb: F0 of the dielectric specular layer over the diffuse base; w: its F90 (0 = Lambertian base)
   uvec4 tex2;         // x: metallicRoughness texture, y: normal texture (kInvalidIndex = none); z: normal scale,
                       // w: alpha cutoff (both float bits)
+  vec4 coat;          // KHR_materials_clearcoat: x: weight (0 = none), y: roughness (GGX alpha = y^2), z: its normal
+                      // map's scale, w: unused
+  vec4 sheen;         // KHR_materials_sheen: rgb: sheen colour (linear; 0 = none), w: sheen roughness
+  uvec4 tex3;         // textures: x: clearcoat (R), y: clearcoat roughness (G), z: clearcoat normal map,
+                      // w: sheen colour (RGB, sRGB)
+  uvec4 tex4;         // textures: x: sheen roughness (A), y: specular (A), z: specular colour (RGB, sRGB),
+                      // w: transmission (R)
+  vec4 specularBase;  // with a specular texture: rgb: ((ior - 1) / (ior + 1))^2 x specularColorFactor (unclamped),
+                      // w: specularFactor: F0 = min(rgb x colour texture, 1) x w x texture A, F90 = w x texture A
 };
+CAUSTICA_CONST uint kMaterialTexels = 12u;  // RGBA32 texels per Material in its buffer texture
 
 // A texture inside the texel SSBO (48 bytes, stored as kTexInfoWords uints at the head of that SSBO).
 // Several may share texels (KHR_texture_transform).
@@ -343,7 +355,7 @@ static_assert(sizeof(BvhWideNode) == 112, "BvhWideNode must be 112 bytes (7 texe
 static_assert(sizeof(InstanceRecord) == 64, "InstanceRecord must be 64 bytes (4 texels)");
 static_assert(sizeof(InstanceShade) == 64, "InstanceShade must be 64 bytes (4 texels)");
 static_assert(sizeof(TriGeom) == 48, "TriGeom must be 48 bytes (std430)");
-static_assert(sizeof(Material) == 112, "Material must be 112 bytes (std430)");
+static_assert(sizeof(Material) == 16 * kMaterialTexels, "Material must be 192 bytes (std430)");
 static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");

@@ -57,7 +57,8 @@ const uint kBsdfSample = 25u;
 const uint kSpotFalloff = 26u;
 const uint kOctDecode = 27u;
 const uint kWrapCoord = 28u;
-const uint kDenoiseTapWeight = 29u;
+const uint kLayers = 29u;
+const uint kDenoiseTapWeight = 30u;
 
 // The Bsdf of records for kBsdfEvalPdf and kBsdfSample: a[0].w = alpha, a[1].w = eta,
 // a[2] = (color, lobe), a[3].xy = (f0 grey, f90).
@@ -126,6 +127,14 @@ void main() {
     int i = int(floatBitsToUint(a[0].x)), n = int(floatBitsToUint(a[0].y));
     o[0] = uvec4(uint(floorMod(i, n)), uint(wrapCoord(i, n, false, false)), uint(wrapCoord(i, n, true, false)),
                  uint(wrapCoord(i, n, false, true)));
+  } else if (function == kLayers) {  // a[0] = (h, alpha), a[1] = (cosO, cosI, roughness, cosCoat),
+                                      // a[2] = (sheen colour, clearcoat), a[3] = (u, base albedo, base luminance)
+    o[0] = bits(vec4(sheenD(a[0].xyz, a[0].w), sheenLambda(a[1].x, a[0].w), sheenVisibility(a[1].x, a[1].y, a[0].w),
+                     sheenAlbedo(a[1].x, a[1].z)));
+    LayerWeights w = layerWeights(a[2].w, a[1].w, a[2].xyz, a[1].z, a[1].x, a[3].w);
+    o[1] = bits(vec4(coatFresnel(a[1].w), w.coat, w.sheen, sheenL(a[1].y, a[0].w)));
+    o[2] = bits(sampleUniformHemisphere(a[3].xy), w.coatPick);
+    o[3] = bits(layeredAlbedo(w, a[2].xyz, vec3(a[3].z)), 0.0);
   } else if (function == kOctDecode) {  // a[0].x: the word (uint)
     o[0] = bits(octDecode(floatBitsToUint(a[0].x)), 0.0);
   } else if (function == kSpotFalloff) {  // a[0].xyz = (cos theta, cos outer, cos inner)

@@ -218,6 +218,44 @@ TEST_CASE("shader features: detection from the materials some triangle uses and 
   CHECK(detect(s).describe() == "glass dispersion textures opacity environment punctual spot-emitters ggx");
 }
 
+// The layers cost nothing where no triangle uses them: a coat, a sheen or a factor texture switches
+// its row on only through a material some triangle has (the shader reads the layer texels only then).
+TEST_CASE("shader features: clear coat, sheen and factor textures only from a material some triangle uses") {
+  Scene s;
+  Material plain, coated, velvet, textured;
+  plain.specularF90 = 1.0f;
+  coated.clearcoat = 0.5f;
+  velvet.sheenColor = glm::vec3(0.0f, 0.2f, 0.0f);
+  textured.specularF90 = 1.0f;
+  textured.transmissionTexture = 0;
+  Texture t;
+  t.width = t.height = 1;
+  t.rgba = {255, 255, 255, 255};
+  s.textures = {t};
+  s.materials = {plain, coated, velvet, textured};
+  addSquare(s, 0.0f, 0);
+  const FeatureSet none = detect(s);
+  CHECK(none.describe() == "ggx");
+  for (const char* d : {"CAUSTICA_CLEARCOAT", "CAUSTICA_SHEEN", "CAUSTICA_FACTOR_TEXTURES"}) CHECK_FALSE(none.has(d));
+  addSquare(s, 1.0f, 1);
+  CHECK(detect(s).describe() == "ggx clearcoat");
+  addSquare(s, 2.0f, 2);
+  CHECK(detect(s).describe() == "ggx clearcoat sheen");
+  addSquare(s, 3.0f, 3);
+  CHECK(detect(s).describe() == "textures ggx clearcoat sheen factor-textures");
+  // The bundled scenes without the extensions compile none of it; cornell-layers compiles both layers.
+  for (const char* name : {"cornell-box", "cornell-glass", "cornell-materials", "cornell-textured", "sun-glass"}) {
+    CAPTURE(std::string(name));
+    const Scene b = loadScene(sourceDir() + "/assets/scenes/" + name + ".gltf");
+    const FeatureSet f = detect(b);
+    for (const char* d : {"CAUSTICA_CLEARCOAT", "CAUSTICA_SHEEN", "CAUSTICA_FACTOR_TEXTURES"}) CHECK_FALSE(f.has(d));
+  }
+  const FeatureSet layers = detect(loadScene(sourceDir() + "/assets/scenes/cornell-layers.gltf"));
+  CHECK(layers.has("CAUSTICA_CLEARCOAT"));
+  CHECK(layers.has("CAUSTICA_SHEEN"));
+  CHECK_FALSE(layers.has("CAUSTICA_FACTOR_TEXTURES"));
+}
+
 TEST_CASE("shader features: an environment map alone turns mis on without the emitter estimate") {
   Scene s;
   s.materials = {Material{}};
@@ -243,7 +281,8 @@ TEST_CASE("shader features: a variant compiles the rows its mode reads, its sett
   s.integrator = Integrator::Naive;  // no mis: no casters, no no-emitter variant (both need it)
   CHECK(joined(variantFeatures(everyRow(), s).defines()) ==
         "CAUSTICA_MIRROR CAUSTICA_GLASS CAUSTICA_VOLUME CAUSTICA_DISPERSION CAUSTICA_TEXTURES CAUSTICA_OPACITY "
-        "CAUSTICA_VERTEX_COLORS CAUSTICA_ENV CAUSTICA_PUNCTUAL CAUSTICA_SPOT_EMITTERS CAUSTICA_GGX CAUSTICA_TRANSPARENT");
+        "CAUSTICA_VERTEX_COLORS CAUSTICA_ENV CAUSTICA_PUNCTUAL CAUSTICA_SPOT_EMITTERS CAUSTICA_GGX CAUSTICA_CLEARCOAT "
+        "CAUSTICA_SHEEN CAUSTICA_FACTOR_TEXTURES CAUSTICA_TRANSPARENT");
 
   s = path;
   // Manifold NEE only when asked and only where the scene has a caster and an emitter: a scene without

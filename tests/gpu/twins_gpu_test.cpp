@@ -18,6 +18,7 @@
 #include "gpu/gl_objects.h"
 #include "gpu/shader_library.h"
 #include "accel/spawn.h"
+#include "shading/layers.h"
 #include "shading/microfacet.h"
 #include "shading/oct_normal.h"
 #include "shading/texture_wrap.h"
@@ -37,7 +38,7 @@ enum class Fn : GLuint {
   PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
   ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
   DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError, Ggx, GgxSampleVisibleNormal, BsdfEvalPdf, BsdfSample, SpotFalloff, OctDecode,
-  WrapCoord, DenoiseTapWeight
+  WrapCoord, Layers, DenoiseTapWeight
 };
 
 constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
@@ -877,10 +878,10 @@ TEST_CASE("GLSL GGX lobes equal their C++ twins: ggxD, ggxLambda, ggxG1, ggxG2, 
   dH.check();
   dHp.check();
 
-  const float lobes[] = {float(kLobeConductor), float(kLobePlastic), float(kLobeRoughGlass)};
+  const float lobes[] = {float(kLobeConductor), float(kLobePlastic), float(kLobeRoughGlass), float(kLobeSheen)};
   std::vector<In> ev, sm;
   while (ev.size() < n) {
-    float lobe = lobes[ev.size() % 3];
+    float lobe = lobes[(ev.size() / 6) % 4];  // every lobe with every eta below
     float eta = kEtas[ev.size() % 6];  // 1.5, 1/1.5, 1.33, 1/1.33, 2.4, 1/2.4 (ior 1 never takes a rough lobe)
     glm::vec4 a0(upper(), r.logUniform(0.02f, 1.0f));
     glm::vec4 a2(r.uniform(), r.uniform(), r.uniform(), lobe), a3(r.uniform(0.0f, 0.1f), r.uniform(), 0, 0);
@@ -901,15 +902,19 @@ TEST_CASE("GLSL GGX lobes equal their C++ twins: ggxD, ggxLambda, ggxG1, ggxG2, 
   // f and pdf relative to max(value, 1e-3): measured 5.6e-4 and 4.9e-5, both at rough refraction out of a
   // dense medium (eta 1/2.4): the generalised half vector eta wi + wo nearly cancels there, and D and the
   // Jacobian amplify its few-ULP difference (dot products that llvmpipe fuses and orders differently).
-  MaxDiff dF("bsdfEval (relative)", 2e-3), dP("bsdfPdf (relative)", 2e-3);
+  // The sheen lobe alone: its D's pow and the Lambda fit's exp (above), measured 1.1e-5.
+  MaxDiff dF("bsdfEval (relative)", 2e-3), dP("bsdfPdf (relative)", 2e-3), dFs("bsdfEval, sheen (relative)", 256 * kEps);
   for (size_t i = 0; i < n; ++i) {
     Bsdf b = bsdfOf(ev[i]);
     glm::vec3 wo(arg(ev[i], 0)), wi(arg(ev[i], 1));
     glm::vec3 f = bsdfEval(b, wo, wi);
     dF.add(relVec(evo[i].v(0), f, 1e-3), [&] { return str(ev[i]) + ": " + str(evo[i].v(0)) + " vs " + str(f); });
+    if (b.lobe == kLobeSheen)
+      dFs.add(relVec(evo[i].v(0), f, 1e-3), [&] { return str(ev[i]) + ": " + str(evo[i].v(0)) + " vs " + str(f); });
     dP.add(relDiff(evo[i].f(0, 3), bsdfPdf(b, wo, wi), 1e-3), [&] { return str(ev[i]); });
   }
   dF.check();
+  dFs.check();
   dP.check();
 
   std::vector<Out> smo = gpu.run(Fn::BsdfSample, sm);
@@ -932,6 +937,63 @@ TEST_CASE("GLSL GGX lobes equal their C++ twins: ggxD, ggxLambda, ggxG1, ggxG2, 
   okSame.check();
   dWi.check();
   dW.check();
+}
+
+TEST_CASE("GLSL layers equal their C++ twins: coatFresnel, sheenD, sheenL, sheenLambda, sheenVisibility, sheenAlbedo, layerWeights, layeredAlbedo, sampleUniformHemisphere") {
+  GlslTwins gpu;
+  Random r(29);
+  const size_t n = 8192;
+  std::vector<In> in;
+  while (in.size() < n) {
+    // Half vectors over the whole upper hemisphere, grazing included; sheen roughness 0.07..1 (and a few
+    // outside, which the table clamps); cosines down to 1e-4.
+    glm::vec3 h = r.unit();
+    h.z = std::abs(h.z);
+    float rough = in.size() % 16 == 0 ? r.uniform(0.0f, 0.07f) : r.uniform(0.07f, 1.0f);
+    glm::vec4 a0(glm::normalize(h), sheenRoughnessClamped(rough) * sheenRoughnessClamped(rough));
+    glm::vec4 a1(r.logUniform(1e-4f, 1.0f), r.logUniform(1e-4f, 1.0f), rough, r.uniform(-1.0f, 1.0f));
+    glm::vec4 a2(r.uniform(), r.uniform(), r.uniform(), r.uniform());
+    if (in.size() % 8 == 1) a2 = glm::vec4(0.0f, 0.0f, 0.0f, a2.w);  // no sheen
+    glm::vec4 a3(r.u2(), r.uniform(), in.size() % 8 == 2 ? 0.0f : r.uniform());
+    in.push_back(floats(a0, a1, a2, a3));
+  }
+  std::vector<Out> out = gpu.run(Fn::Layers, in);
+  auto relVec = [](const glm::vec3& g, const glm::vec3& c, double floor) {
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d = std::max(d, relDiff(g[k], c[k], floor));
+    return d;
+  };
+  // coatFresnel, the layer weights and the albedo: a few multiplications (measured 5.7e-7). sheenD: a pow
+  // with exponent up to 102 amplifies one ULP of sin^2 by that much (measured 1.1e-5). sheenL: a sum of
+  // terms up to 25 that may cancel, so absolute (measured 3.8e-6); sheenLambda and sheenVisibility:
+  // exp of it (measured 4.6e-6 and 4.1e-6). sheenAlbedo: a bilinear lookup (measured 5.3e-7). The
+  // hemisphere sample: cos and sin of 2 pi u (measured 6e-8).
+  MaxDiff dCoat("coatFresnel, layerWeights, layeredAlbedo (relative)", 8 * kEps);
+  MaxDiff dD("sheenD (relative)", 128 * kEps), dL("sheenL (absolute; its terms are up to 25)", 64 * kEps);
+  MaxDiff dLam("sheenLambda (relative)", 64 * kEps), dV("sheenVisibility (relative)", 64 * kEps);
+  MaxDiff dE("sheenAlbedo (relative)", 8 * kEps), dDir("sampleUniformHemisphere", 8 * kEps);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec4 a0 = arg(in[i], 0), a1 = arg(in[i], 1), a2 = arg(in[i], 2), a3 = arg(in[i], 3);
+    const auto where = [&] { return str(in[i]); };
+    dD.add(relDiff(out[i].f(0, 0), sheenD(glm::vec3(a0), a0.w), 1e-20), where);
+    dLam.add(relDiff(out[i].f(0, 1), sheenLambda(a1.x, a0.w), 1e-20), where);
+    dV.add(relDiff(out[i].f(0, 2), sheenVisibility(a1.x, a1.y, a0.w), 1e-20), where);
+    dL.add(absDiff(out[i].f(1, 3), sheenL(a1.y, a0.w)), where);
+    dE.add(relDiff(out[i].f(0, 3), sheenAlbedo(a1.x, a1.z), 1e-6), where);
+    LayerWeights w = layerWeights(a2.w, a1.w, glm::vec3(a2), a1.z, a1.x, a3.w);
+    dCoat.add(std::max({relDiff(out[i].f(1, 0), coatFresnel(a1.w), 1e-6), relDiff(out[i].f(1, 1), w.coat, 1e-6),
+                        relDiff(out[i].f(1, 2), w.sheen, 1e-6), relDiff(out[i].f(2, 3), w.coatPick, 1e-6),
+                        relVec(out[i].v(3), layeredAlbedo(w, glm::vec3(a2), glm::vec3(a3.z)), 1e-6)}),
+              where);
+    dDir.add(absDiff(out[i].v(2), sampleUniformHemisphere(glm::vec2(a3))), where);
+  }
+  dCoat.check();
+  dD.check();
+  dL.check();
+  dLam.check();
+  dV.check();
+  dE.check();
+  dDir.check();
 }
 
 TEST_CASE("GLSL denoiser arithmetic equals its C++ twin: denoiseTapWeight, denoiseNormalWeight, denoiseMeanVariance, "

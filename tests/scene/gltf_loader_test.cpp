@@ -40,7 +40,7 @@ TEST_CASE("every shipped scene loads with triangles, lights, a camera and consis
                          "assets/scenes/cornell-bunny-light.gltf",  "assets/scenes/cornell-textured.gltf",
                          "assets/scenes/cornell-dispersion.gltf",   "tests/data/scenes/furnace.gltf",
                          "tests/data/scenes/furnace-glass.gltf",    "tests/data/scenes/glass-in-white-enclosure.gltf",
-                         "tests/data/scenes/small-cornell.gltf"};
+                         "tests/data/scenes/small-cornell.gltf",    "assets/scenes/cornell-layers.gltf"};
   for (const std::string file : files) {
     CAPTURE(file);
     const Scene s = caustica::loadScene(source(file));
@@ -676,6 +676,110 @@ TEST_CASE("textures: metallicRoughness, normal, MASK with texture alpha, KHR_tex
   for (const auto& w : s.warnings) CHECK(w.find("normalTexture") == std::string::npos);
 }
 
+TEST_CASE("layers and unlit: KHR_materials_clearcoat, KHR_materials_sheen, KHR_materials_unlit and the factor textures") {
+  TempDir dir;
+  const unsigned char png[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+  REQUIRE(stbi_write_png((dir.path / "tiny.png").string().c_str(), 2, 2, 4, png, 8));
+  Gltf g;
+  g.doc["images"] = {{{"uri", "tiny.png"}}, {{"uri", "tiny.png"}}};
+  g.doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  const json transform = {{"KHR_texture_transform", {{"offset", {0.5, 0.0}}}}};
+  const int coated = g.add(
+      "materials",
+      {{"name", "coated"},
+       {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"baseColorFactor", {0.5, 0.02, 0.01, 1.0}}}},
+       {"extensions",
+        {{"KHR_materials_clearcoat",
+          {{"clearcoatFactor", 0.8},
+           {"clearcoatRoughnessFactor", 0.1},
+           {"clearcoatTexture", {{"index", 0}}},
+           {"clearcoatRoughnessTexture", {{"index", 1}, {"extensions", transform}}},
+           {"clearcoatNormalTexture", {{"index", 1}, {"scale", 0.5}}}}}}}});
+  const int velvet = g.add("materials",
+                           {{"name", "velvet"},
+                            {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+                            {"extensions",
+                             {{"KHR_materials_sheen",
+                               {{"sheenColorFactor", {0.9, 0.5, 0.1}},
+                                {"sheenRoughnessFactor", 0.3},
+                                {"sheenColorTexture", {{"index", 0}}},
+                                {"sheenRoughnessTexture", {{"index", 1}}}}}}}});
+  const int unlit = g.add("materials", {{"name", "unlit"},
+                                        {"pbrMetallicRoughness",
+                                         {{"baseColorFactor", {0.2, 0.4, 0.6, 1.0}},
+                                          {"baseColorTexture", {{"index", 0}}},
+                                          {"metallicFactor", 1.0}}},
+                                        {"emissiveFactor", {1.0, 1.0, 1.0}},
+                                        {"doubleSided", true},
+                                        {"extensions", {{"KHR_materials_unlit", json::object()}}}});
+  const int textured = g.add(
+      "materials", {{"name", "textured factors"},
+                    {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+                    {"extensions",
+                     {{"KHR_materials_transmission", {{"transmissionFactor", 0.5}, {"transmissionTexture", {{"index", 0}}}}},
+                      {"KHR_materials_specular",
+                       {{"specularFactor", 0.5},
+                        {"specularColorFactor", {1.0, 0.5, 2.0}},
+                        {"specularTexture", {{"index", 1}}},
+                        {"specularColorTexture", {{"index", 0}}}}}}}});
+  const int plain = g.add("materials", {{"name", "no layers"},
+                                        {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+                                        {"extensions",
+                                         {{"KHR_materials_clearcoat", {{"clearcoatTexture", {{"index", 0}}}}},
+                                          {"KHR_materials_sheen", {{"sheenRoughnessFactor", 0.5}}}}}});
+  for (int m : {coated, velvet, unlit, textured, plain})
+    g.root({{"mesh", g.mesh({{"attributes", {{"POSITION", g.positions(kTriangle)}}}, {"material", m}})}});
+  g.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit",
+                             "KHR_materials_transmission", "KHR_materials_specular", "KHR_texture_transform"};
+  g.doc["extensionsRequired"] = {"KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit"};
+  const Scene s = g.load(dir);
+  const caustica::Material* c = findMaterial(s, "coated");
+  CHECK(c->clearcoat == doctest::Approx(0.8));
+  CHECK(c->clearcoatRoughness == doctest::Approx(0.1));
+  CHECK(c->clearcoatTexture >= 0);
+  REQUIRE(c->clearcoatRoughnessTexture >= 0);
+  CHECK(s.textures[std::size_t(c->clearcoatRoughnessTexture)].uvRow0.z == doctest::Approx(0.5));  // its transform
+  CHECK(c->clearcoatNormalTexture >= 0);
+  CHECK(c->clearcoatNormalScale == 0.5f);
+  CHECK(c->hasClearcoat());
+  CHECK(c->readsTextures());
+  const caustica::Material* v = findMaterial(s, "velvet");
+  CHECK(v->sheenColor == glm::vec3(0.9f, 0.5f, 0.1f));
+  CHECK(v->sheenRoughness == doctest::Approx(0.3));
+  CHECK(v->sheenColorTexture >= 0);
+  CHECK(v->sheenRoughnessTexture >= 0);
+  CHECK(v->hasSheen());
+  // Unlit: an emitter of its base colour (factor x texture) that reflects nothing; the PBR fallbacks
+  // (metal, emission) are not used, doubleSided is.
+  const caustica::Material* u = findMaterial(s, "unlit");
+  CHECK(u->unlit);
+  CHECK(u->emission == glm::vec3(0.2f, 0.4f, 0.6f));
+  CHECK(u->emissiveTexture >= 0);
+  CHECK(u->baseColor == glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  CHECK(u->baseColorTexture == -1);  // OPAQUE: its alpha is not read
+  CHECK(u->metallic == 0.0f);
+  CHECK(u->specularF90 == 0.0f);
+  CHECK(u->doubleSided);
+  const caustica::Material* t = findMaterial(s, "textured factors");
+  CHECK(t->transmissionTexture >= 0);
+  CHECK(t->specularTexture >= 0);
+  CHECK(t->specularColorTexture >= 0);
+  CHECK(t->specularColorFactor == glm::vec3(1.0f, 0.5f, 2.0f));
+  CHECK(t->specularFactor == 0.5f);
+  CHECK(t->hasFactorTextures());
+  // Layers that are off (no factor, no colour) keep no textures: nothing to read.
+  const caustica::Material* p = findMaterial(s, "no layers");
+  CHECK(!p->hasClearcoat());
+  CHECK(!p->hasSheen());
+  CHECK(p->clearcoatTexture == -1);
+  CHECK(!p->readsTextures());
+  for (const auto& w : s.warnings) {
+    CAPTURE(w);
+    CHECK(w.find("Texture") == std::string::npos);  // no texture is ignored any more
+    CHECK(w.find("unsupported") == std::string::npos);
+  }
+}
+
 TEST_CASE("textures: a material whose textures all name TEXCOORD_1 reads that set; mixed sets fall back to TEXCOORD_0") {
   TempDir dir;
   const unsigned char png[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
@@ -1137,7 +1241,8 @@ TEST_CASE("nothing dropped in silence: what is not rendered is named in one warn
                            {"material", mat}});
   g.root({{"mesh", mesh}});
   g.doc["scenes"].push_back({{"nodes", json::array()}});
-  g.doc["extensionsUsed"] = {"KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_animation_pointer"};
+  g.doc["extensionsUsed"] = {"KHR_materials_iridescence", "KHR_materials_sheen", "KHR_materials_clearcoat",
+                             "KHR_materials_unlit", "KHR_animation_pointer"};
   const Scene s = g.load(dir);
   std::vector<std::string> lines;
   for (const std::string& w : s.warnings)
@@ -1145,7 +1250,11 @@ TEST_CASE("nothing dropped in silence: what is not rendered is named in one warn
   REQUIRE(lines.size() == 1);
   const std::string& line = lines[0];
   CHECK(line.rfind(s.path + ": not rendered: ", 0) == 0);
-  for (const char* named : {"extension(s) KHR_animation_pointer, KHR_materials_clearcoat, KHR_materials_sheen",
+  for (const char* rendered : {"clearcoat", "sheen", "unlit", "specular", "transmission"}) {  // the layers are rendered
+    CAPTURE(std::string(rendered));
+    CHECK(line.find(rendered) == std::string::npos);
+  }
+  for (const char* named : {"extension(s) KHR_animation_pointer, KHR_materials_iridescence",
                             "vertex attribute(s) COLOR_1, TEXCOORD_2, _BATCHID",
                             "1 scene(s) besides the default one", "'aged': occlusionTexture"}) {
     CAPTURE(std::string(named));

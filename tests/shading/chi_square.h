@@ -36,4 +36,12 @@ inline double chiSquareLimit(int dof) {
   return k * t * t * t;
 }
 
+// Upper-tail probability of the chi-square distribution with dof degrees of freedom at chi (Wilson–Hilferty
+// normal approximation): the p-value the tests print.
+inline double chiSquarePValue(double chi, int dof) {
+  double k = dof, v = 2.0 / (9.0 * k);
+  double z = (std::cbrt(chi / k) - (1.0 - v)) / std::sqrt(v);
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
 }  // namespace caustica::test

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "shading/microfacet.h"
@@ -16,6 +17,7 @@
 using namespace caustica;
 using caustica::test::chiSquare;
 using caustica::test::chiSquareLimit;
+using caustica::test::chiSquarePValue;
 
 namespace {
 
@@ -30,7 +32,7 @@ glm::vec3 unitWo(float cosTheta) { return dirFromCosPhi(cosTheta, 0.7); }
 // angle); expected counts by a midpoint rule of sub x sub points per bin. Also checks that the pdf's
 // integral equals the fraction of samples that were not lost.
 template <class Sample, class Pdf>
-void checkSampler(Sample sample, Pdf pdf, int n, std::uint32_t seed) {
+void checkSampler(Sample sample, Pdf pdf, int n, std::uint32_t seed, const char* label = nullptr) {
   const int nCos = 20, nPhi = 24, sub = 24;
   std::vector<double> obs(nCos * nPhi, 0.0), exp(nCos * nPhi, 0.0);
   RngState rng = rngSeed(seed, 1, 2);
@@ -64,6 +66,7 @@ void checkSampler(Sample sample, Pdf pdf, int n, std::uint32_t seed) {
   double chi = chiSquare(obs, exp, dof);
   CAPTURE(chi);
   CAPTURE(dof);
+  if (label) std::printf("chi-square %s: %.1f with %d degrees of freedom, p = %.3f\n", label, chi, dof, chiSquarePValue(chi, dof));
   CHECK(chi < chiSquareLimit(dof));
   // The pdf integrates to the probability that a sample is produced (quadrature error < 0.5 %).
   CHECK(std::abs(total / n - double(produced) / n) < 0.005 + 4.0 / std::sqrt(double(n)));
@@ -132,7 +135,7 @@ TEST_CASE("GGX visible normals: chi-square against G1 max(0, wo.h) D / wo.z") {
     }
 }
 
-TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe") {
+TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe, the clear coat and the sheen") {
   Bsdf metal;
   metal.lobe = kLobeConductor;
   metal.color = glm::vec3(0.9f, 0.6f, 0.3f);
@@ -144,10 +147,17 @@ TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe") {
   Bsdf glass;
   glass.lobe = kLobeRoughGlass;
   glass.color = glm::vec3(1.0f);
+  Bsdf sheen;
+  sheen.lobe = kLobeSheen;
+  sheen.color = glm::vec3(1.0f, 0.5f, 0.2f);
+  Bsdf coat;  // the clear coat's lobe: a white GGX reflection (F = 1) about the coat normal (layers.glsl)
+  coat.lobe = kLobeConductor;
+  coat.color = glm::vec3(1.0f);
+  const char* names[] = {"rough metal", "plastic", "rough glass entering", "rough glass leaving", "sheen", "clear coat"};
   for (float alpha : {0.3f, 0.7f})
     for (float cosO : {0.9f, 0.3f})
-      for (int k = 0; k < 4; ++k) {
-        Bsdf b = k == 0 ? metal : k == 1 ? plastic : glass;
+      for (int k = 0; k < 6; ++k) {
+        Bsdf b = k == 0 ? metal : k == 1 ? plastic : k == 4 ? sheen : k == 5 ? coat : glass;
         b.alpha = alpha;
         if (k == 3) b.eta = 1.0f / 1.5f;  // leaving glass: total internal reflection beyond ~42 degrees
         CAPTURE(alpha);
@@ -165,7 +175,10 @@ TEST_CASE("bsdfSample: chi-square against bsdfPdf for every GGX lobe") {
               REQUIRE(s.transmitted == (s.wi.z < 0.0f));
               return true;
             },
-            [&](const glm::vec3& w) { return double(bsdfPdf(b, wo, w)); }, 200000, 17 + std::uint32_t(k));
+            [&](const glm::vec3& w) { return double(bsdfPdf(b, wo, w)); }, 200000, 17 + std::uint32_t(k),
+            (std::string(names[k]) + ", alpha " + std::to_string(alpha).substr(0, 3) + ", cos " +
+             std::to_string(cosO).substr(0, 3))
+                .c_str());
       }
 }
 
