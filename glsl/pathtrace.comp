@@ -20,9 +20,13 @@
 #if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
 #include "lib/punctual.glsl"
 #endif
-#ifdef CAUSTICA_CASTERS
+#if defined(CAUSTICA_CASTERS) || defined(CAUSTICA_MANIFOLD)
 #include "lib/casters.glsl"
 #endif
+#ifdef CAUSTICA_MANIFOLD
+#include "lib/caustic_cells.glsl"
+#endif
+
 #include "lib/vertex.glsl"
 #include "lib/accumulate.glsl"
 #ifdef CAUSTICA_TRANSPARENT
@@ -39,6 +43,10 @@ layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y)
 #include "lib/path_state.glsl"
 #ifdef CAUSTICA_ENV
 #include "lib/environment_light.glsl"
+#endif
+#ifdef CAUSTICA_MANIFOLD
+#include "lib/manifold.glsl"
+#include "lib/path_manifold.glsl"
 #endif
 #include "lib/path_emission.glsl"
 #include "lib/path_nee.glsl"
@@ -71,22 +79,35 @@ bool pathBounce(inout PathState s) {
 #endif
   addEmission(s, sf);                           // path_emission.glsl: with its MIS weight
   BounceLobe lobe = chooseBounceLobe(s, sf, base.rgb);  // path_scatter.glsl
+  bool nonDelta = isDiffuseLobe(lobe) || isGlossyLobe(lobe);
 #ifdef CAUSTICA_AOV
   // The first non-specular hit, or an emitter (albedo 1: its radiance is not divided by a colour).
   if (surfaceEmits(sf) || isDiffuseLobe(lobe) || isGlossyLobe(lobe))
     featuresRecord(s.feat, surfaceEmits(sf) ? vec3(1.0) : lobe.color, sf.ns, false);
 #endif
+#ifdef CAUSTICA_MANIFOLD
+  bool firstDiffuse = s.firstDiffuse;  // sampleCasterMixture clears it
+#endif
   vec3 newDir;
-  if (isDiffuseLobe(lobe) || isGlossyLobe(lobe)) {
+  Vertex v;
+  if (nonDelta) {
 #ifdef CAUSTICA_CASTERS
     if (isDiffuseLobe(lobe)) newDir = sampleCasterMixture(s, sf);  // its numbers before the lights'
 #endif
-    Vertex v = lobeVertex(s, sf, lobe);
-    addDirectLight(s, v, isDiffuseLobe(lobe));           // path_nee.glsl: next-event estimation
+    v = lobeVertex(s, sf, lobe);
+    addDirectLight(s, v, isDiffuseLobe(lobe));  // path_nee.glsl: next-event estimation
+  }
+#ifdef CAUSTICA_MANIFOLD
+  bool atX = addManifoldLight(s, sf, isDiffuseLobe(lobe), firstDiffuse, v);  // path_manifold.glsl: light through a caster, or the weight of a bounce's
+#endif
+  if (nonDelta) {
     if (!scatterNonDelta(s, sf, v, lobe, newDir)) return false;
   } else {
     scatterDelta(s, sf, lobe, newDir);  // mirror, smooth glass
   }
+#ifdef CAUSTICA_MANIFOLD
+  trackCasterChain(s, sf, lobe.lobe, newDir, atX);
+#endif
   if (!russianRoulette(s)) return false;  // path_state.glsl
   continuePath(s, sf, newDir);
   return true;

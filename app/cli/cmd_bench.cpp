@@ -14,7 +14,7 @@ int cmdBench(const std::vector<std::string>& args) {
   std::vector<OptionSpec> specs = {
       {"--size", "", "W[xH]", "image size in pixels (default 256; H follows the camera's aspect)"},
       {"--max-seconds", "", "S", "render time per estimator run in seconds (default 20)"},
-      {"--integrators", "", "LIST", "estimators to compare, comma-separated (default naive,mis)"},
+      {"--integrators", "", "LIST", "estimators to compare, comma-separated: naive, mis, manifold (mis with manifold NEE) (default naive,mis)"},
       {"--adaptive", "", "LIST",
        "estimators that also get an adaptive-sampling run, comma-separated (default mis; none for none)"},
       {"--dispersion", "", "LIST", "dispersion modes for scenes with dispersive glass (default rgb,spectral)"},
@@ -35,6 +35,7 @@ int cmdBench(const std::vector<std::string>& args) {
        "256 spp (OUT/denoise.csv, bench-denoise-SCENE.png plots and -pictures.png figures, a summary table; docs/denoising.md)"},
       sceneOptionSpec("--max-depth"),
       sceneOptionSpec("--caster-probability"),
+      sceneOptionSpec("--manifold"),
       sceneOptionSpec("--camera"),
       sceneOptionSpec("--backend"),
       sceneOptionSpec("--shader-dir"),

@@ -74,7 +74,8 @@ SettingsChange compareSettings(const RenderSettings& from, const RenderSettings&
   c.restart = from != to;
   c.resize = from.width != to.width || from.height != to.height;
   c.shader = from.integrator != to.integrator || from.dispersion != to.dispersion ||
-             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.mode != to.mode ||
+             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.manifold != to.manifold ||
+             from.mode != to.mode ||
              from.allFeatures != to.allFeatures;
   c.casters = from.casterProbability != to.casterProbability;
   return c;

@@ -36,6 +36,10 @@ struct RenderSettings {
   // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
   // instead of cosine sampling; 0 turns it off; at most kMaxCasterProbability.
   float casterProbability = 0.5f;
+  // mis only: manifold next-event estimation, which joins the light sample at a path's first diffuse
+  // vertex to it through a glass or mirror caster (docs/path-tracer.md); scenes without casters or
+  // emitters never use it. Off by default until it measures faster (docs/path-tracer.md).
+  bool manifold = false;
   RenderMode mode = RenderMode::Path;
   // Compile every material feature into the path tracer, whatever the scene uses (the shader is
   // otherwise specialised to the scene's features): measures what specialisation saves
@@ -81,6 +85,7 @@ void visitFields(Settings& s, Visit&& visit) {
   visit("integrator", SettingRole::Accumulation, s.integrator);
   visit("dispersion", SettingRole::Accumulation, s.dispersion);
   visit("caster-probability", SettingRole::Accumulation, s.casterProbability);
+  visit("manifold", SettingRole::Accumulation, s.manifold);
   visit("mode", SettingRole::Accumulation, s.mode);
   // The same expected image; the same bits on llvmpipe (tests/gpu/error_estimate_test.cpp), to float
   // rounding elsewhere.
@@ -89,7 +94,7 @@ void visitFields(Settings& s, Visit&& visit) {
   visit("samples-per-dispatch", SettingRole::Speed, s.samplesPerDispatch);
 }
 // Added a field to RenderSettings? Add it to visitFields above (with its role), then count it here.
-static_assert(fieldCount<RenderSettings>() == 10, "RenderSettings has a field that visitFields does not list");
+static_assert(fieldCount<RenderSettings>() == 11, "RenderSettings has a field that visitFields does not list");
 
 // A setting's value as one word of text, the same in the checkpoint identity and printed settings
 // (a float as the shortest text that reads back as the same float: 0.05f is "0.05").
@@ -108,7 +113,7 @@ std::string settingText(RenderMode v);
 struct SettingsChange {
   bool restart = false;  // anything differs: the accumulated samples no longer belong to the image
   bool resize = false;   // width or height: new accumulation images
-  bool shader = false;   // integrator, dispersion mode, caster aiming on/off or render mode: maybe another variant
+  bool shader = false;   // integrator, dispersion mode, caster aiming or manifold NEE on/off, render mode: maybe another variant
   bool casters = false;  // caster probability: the caster UBO
 };
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to);

@@ -272,6 +272,9 @@ std::vector<std::string> Renderer::shaderDefines() const {
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
+  // The caustic photon pass, once per scene, before the first variant with manifold NEE runs.
+  if (!causticCells_.built() && std::find(defines.begin(), defines.end(), "CAUSTICA_MANIFOLD") != defines.end())
+    buildCausticCells();
   const char* entry = renderModeSpec(settings_.mode).entryShader;
   if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
   std::string key = std::string(entry) + ":";
@@ -339,8 +342,28 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   return change;
 }
 
-void Renderer::uploadCasters() {
+void Renderer::buildCausticCells() {
+  std::vector<std::string> defines = sceneFeatures_.only(FeatureKind::Scene).defines();  // materials as the scene needs
+  for (const std::string& split : bufferLayout_.defines()) defines.push_back(split);
+  for (const std::string& inst : gpuScene_.instanceDefines()) defines.push_back(inst);
+  ExpandedShader src = library_.expand("caustic_photons.comp", defines);
+  GlProgram photons =
+      GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); }, "caustic_photons.comp");
+  gpu::FrameParams fp{};
+  fp.options = glm::uvec4(settings_.maxDepth, 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), 1u);  // lights.glsl reads the emitter count
+  frameUbo_.update(0, sizeof fp, &fp);
+  bindSceneForDispatch();
+  gpu::CasterParams cp = casterParams();
+  causticCells_.build(photons, cp, [&](const gpu::CasterParams& built) {
+    cellTableMask_ = built.count.z;
+    uploadCasters();
+  });
+  checkGlError("caustic photon pass");
+}
+
+gpu::CasterParams Renderer::casterParams() const {
   gpu::CasterParams cp{};
+  cp.count.z = cellTableMask_;
   cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
   cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, 0.0f, 0.0f);
   cp.lights = gpuScene_.emitterSphere;
@@ -348,6 +371,11 @@ void Renderer::uploadCasters() {
     cp.sphere[i] = gpuScene_.casters[i].sphere;
     if (gpuScene_.casters[i].refractive) cp.count.y |= 1u << i;
   }
+  return cp;
+}
+
+void Renderer::uploadCasters() {
+  const gpu::CasterParams cp = casterParams();
   casterUbo_.update(0, sizeof cp, &cp);
 }
 
@@ -481,14 +509,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   fp.tile = glm::uvec4(0, y0, w, y1 - y0);
 
   prog.use();
-  for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
-  frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
-  casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
-  pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
-  environment_.bind();
-  bvhTextures_.bind();
-  shadingTextures_.bind();
-  punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
+  bindSceneForDispatch();
   accum_.bindImage(CAUSTICA_IMAGE_ACCUM, GL_READ_WRITE);
   comp_.bindImage(CAUSTICA_IMAGE_COMP, GL_READ_WRITE);
   half_.bindImage(CAUSTICA_IMAGE_HALF, GL_READ_WRITE);
@@ -534,6 +555,18 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   checkGlError("path tracing dispatch");
   readCounters();  // waits for the dispatches
   if (load_.firstPass == 0.0) load_.firstPass = std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count();
+}
+
+void Renderer::bindSceneForDispatch() {
+  for (GLuint i = 0; i < buffers_.size(); ++i) buffers_[i].bindBase(GL_SHADER_STORAGE_BUFFER, i);
+  frameUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_FRAME);
+  casterUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
+  pointLightUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_POINT_LIGHTS);
+  environment_.bind();
+  bvhTextures_.bind();
+  shadingTextures_.bind();
+  causticCells_.bind();
+  punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
 }
 
 void Renderer::endPass(int spp) {

@@ -10,6 +10,7 @@
 
 #include "accel/bvh.h"
 #include "gpu/bvh_textures.h"
+#include "gpu/caustic_cells.h"
 #include "gpu/shading_textures.h"
 #include "gpu/environment_textures.h"
 #include "gpu/gl_limits.h"
@@ -201,6 +202,10 @@ class Renderer {
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
   void uploadCasters();
   Image meansOf(const std::vector<float>& rgba) const;  // meanImage of sums like accum_'s, with coverage alpha
+  gpu::CasterParams casterParams() const;  // the caster UBO for the current settings and cells
+  // The caustic photon pass (caustic_cells.h), once per scene, before the first manifold NEE variant runs.
+  void buildCausticCells();
+  void bindSceneForDispatch();  // the scene's storage blocks, UBOs and textures, as the compute shaders read them
   // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
   void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
@@ -231,6 +236,8 @@ class Renderer {
   ShadingTextures shadingTextures_;  // the shading's views of the materials, light-tree and texture buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
+  std::uint32_t cellTableMask_ = 0;  // CasterParams::count.z: the caustic cell table's bucket mask, once built
+  CausticCells causticCells_;
   std::vector<LightGroup> lightGroups_;
   gpu::PointLights pointLights_{};
   GlBuffer pointLightUbo_;

@@ -98,6 +98,12 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        "mis, a caustic caster and --caster-probability > 0", nullptr,
        [](const SceneView& v) { return !v.gpu.casters.empty(); },
        [](const RenderSettings& s) { return s.casterProbability > 0.0f; }, "CAUSTICA_MIS", A::Keep},
+      {"manifold", "CAUSTICA_MANIFOLD", K::Integrator,
+       "manifold next-event estimation: light joined to the first diffuse vertex through one glass or mirror "
+       "caster (glsl/lib/path_manifold.glsl), after a caustic photon pass",
+       "mis, a caustic caster, an emissive triangle and --manifold on", nullptr,
+       [](const SceneView& v) { return !v.gpu.casters.empty() && v.gpu.emitterCount > 0; },
+       [](const RenderSettings& s) { return s.manifold; }, "CAUSTICA_MIS", A::Keep},
       {"no-emitters", "CAUSTICA_NO_EMITTERS", K::Integrator,
        "leaves the emitter estimate and the emitter-hit pdf out of mis rather than run them masked on every "
        "bounce (llvmpipe runs every branch)",

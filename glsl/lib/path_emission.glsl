@@ -32,6 +32,14 @@ void addEmission(inout PathState s, Surface sf) {
       w *= powerHeuristic(s.prevPdf, pdfLight);
     }
 #endif
-    s.radiance += s.beta * s.filt * materialEmissionSeen(sf.m, sf.uv, dot(sf.ngFront, s.dir)) * w;
+    vec3 le = s.beta * s.filt * materialEmissionSeen(sf.m, sf.uv, dot(sf.ngFront, s.dir)) * w;
+#ifdef CAUSTICA_MANIFOLD
+    gManifoldCheck = manifoldChainEnds(s);  // a caster chain from x ends here: weighed after the solve
+    if (gManifoldCheck) {
+      gManifoldDeferred = le;
+      return;
+    }
+#endif
+    s.radiance += le;
   }
 }

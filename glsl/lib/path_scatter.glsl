@@ -20,6 +20,9 @@ bool passThrough(inout PathState s, Surface sf, float alpha) {
     s.prevDelta = true;
     if (s.passThroughs < kMaxPassThroughs) ++s.passThroughs;  // up to that many layers of cut-outs are free
     else ++s.depth;
+#ifdef CAUSTICA_MANIFOLD
+    if (s.chain != 0u) s.chain = kChainDead;  // not a caster's event: the chain from x ends
+#endif
     return true;
   }
   return false;
@@ -32,17 +35,7 @@ float glassIor(Material m, inout float lambda, inout vec3 filt, inout uvec4 rng)
   float ior = m.params.w;
 #ifdef CAUSTICA_DISPERSION
   if ((m.tex.z & kMatDispersive) != 0u) {
-    if (lambda == 0.0) {  // the path keeps one wavelength from its first dispersive event on
-#ifdef CAUSTICA_SPECTRAL
-      lambda = kLambdaMin + (kLambdaMax - kLambdaMin) * rand01(rng);
-      filt = channelSensitivity(lambda) * (kLambdaMax - kLambdaMin);
-#else
-      int c = min(int(rand01(rng) * 3.0), 2);
-      lambda = kChannelLambda[c];
-      filt = vec3(0.0);
-      filt[c] = 3.0;
-#endif
-    }
+    if (lambda == 0.0) pickWavelength(rand01(rng), lambda, filt);  // kept from its first dispersive event on
     ior = cauchyIor(ior, m.absorption.w, lambda);
   }
 #endif

@@ -22,6 +22,15 @@ struct PathState {
   uint depth;          // bounces so far (path segments traced, alpha pass-throughs not counted)
   uint passThroughs;   // alpha pass-throughs: not bounces, so they do not consume the depth cap
   uvec4 rng;
+#ifdef CAUSTICA_MANIFOLD
+  // The first diffuse vertex x from which casters were usable, and what followed it (path_manifold.glsl).
+  uint chain;          // kChain* bits
+  vec3 mx, mxN;        // x and its shading normal
+  vec3 mxOrg;          // origin of rays leaving x on the side of its geometric normal
+  vec3 mxSigma;        // absorption coefficient of the medium around x
+  vec3 mxDir;          // the direction the path took from x, and its solid-angle pdf
+  float mxPdf;
+#endif
 #ifdef CAUSTICA_AOV
   SampleFeatures feat;  // the denoiser's features of this sample (feature_buffers.glsl)
 #endif
@@ -46,6 +55,11 @@ PathState startPath(uvec2 pixel, uint sampleIndex) {
   s.firstDiffuse = true;
   s.depth = 0u;
   s.passThroughs = 0u;
+#ifdef CAUSTICA_MANIFOLD
+  s.chain = 0u;
+  s.mx = s.mxN = s.mxOrg = s.mxSigma = s.mxDir = vec3(0.0);
+  s.mxPdf = 0.0;
+#endif
 #ifdef CAUSTICA_AOV
   s.feat = noFeatures();
 #endif

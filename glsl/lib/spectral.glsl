@@ -23,3 +23,18 @@ float cauchyIor(float iorD, float abbe, float lambdaNm) {
   float a = iorD - b / (lD * lD);
   return a + b / (lambdaNm * lambdaNm);
 }
+
+// The wavelength a path keeps from its first dispersive event on, chosen with u uniform in [0, 1), and
+// its per-channel weight: a hero wavelength uniform over the visible range weighted by the channel
+// sensitivities (CAUSTICA_SPECTRAL), or one RGB channel at its mean wavelength weighted 3.
+void pickWavelength(float u, out float lambda, out vec3 filt) {
+#ifdef CAUSTICA_SPECTRAL
+  lambda = kLambdaMin + (kLambdaMax - kLambdaMin) * u;
+  filt = channelSensitivity(lambda) * (kLambdaMax - kLambdaMin);
+#else
+  int c = min(int(u * 3.0), 2);
+  lambda = kChannelLambda[c];
+  filt = vec3(0.0);
+  filt[c] = 3.0;
+#endif
+}

@@ -23,24 +23,38 @@ struct Surface {
 #endif
 };
 
-// The surface at closest hit `hit` of a ray along unit direction dir; false for a triangle of zero
-// area (no normal: the ray is lost). normalMapped: apply the material's normal map (CAUSTICA_TEXTURES);
-// a constant at each call site, folded away where it is false.
-bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
-#ifdef CAUSTICA_INSTANCED
-  InstanceXform xf = instanceXform(hit.inst);
+// The triangle a closest hit found, as its shading reads it: positions (TriGeom, world space), vertex
+// normals (unit or 0) and texcoords, in corner order (instanced: hit.u, hit.v follow a mirrored instance).
+struct HitTriangle {
   TriGeom g;
-  vec3 sn0, sn1, sn2;
-  vec2 st0, st1, st2;
-  instanceHitTriangle(hit, xf, g, sn0, sn1, sn2, st0, st1, st2);  // instances.glsl: world space
-  sf.g = g;
-  sf.xf = xf;
+  vec3 n0, n1, n2;
+  vec2 t0, t1, t2;
+#ifdef CAUSTICA_INSTANCED
+  InstanceXform xf;  // its instance
+#endif
+};
+
+HitTriangle hitTriangle(inout Hit hit) {
+  HitTriangle h;
+#ifdef CAUSTICA_INSTANCED
+  h.xf = instanceXform(hit.inst);
+  instanceHitTriangle(hit, h.xf, h.g, h.n0, h.n1, h.n2, h.t0, h.t1, h.t2);  // instances.glsl: world space
 #else
-  TriGeom g = triGeomAt(hit.tri);
-  vec3 sn0, sn1, sn2;
-  vec2 st0, st1, st2;
-  triNormals(hit.tri, sn0, sn1, sn2);  // tri_shade.glsl
-  triUvs(hit.tri, st0, st1, st2);
+  h.g = triGeomAt(hit.tri);
+  triNormals(hit.tri, h.n0, h.n1, h.n2);  // tri_shade.glsl
+  triUvs(hit.tri, h.t0, h.t1, h.t2);
+#endif
+  return h;
+}
+
+// The surface at closest hit `hit` on triangle h (hitTriangle) of a ray along unit direction dir;
+// false for a triangle of zero area (no normal: the ray is lost). normalMapped: apply the material's
+// normal map (CAUSTICA_TEXTURES); a constant at each call site, folded away where it is false.
+bool surfaceOn(Hit hit, HitTriangle h, vec3 dir, bool normalMapped, out Surface sf) {
+  TriGeom g = h.g;
+#ifdef CAUSTICA_INSTANCED
+  sf.g = g;
+  sf.xf = h.xf;
 #endif
   sf.t = hit.t;
   sf.tri = hit.tri;
@@ -48,7 +62,7 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   sf.p = b0 * g.v0.xyz + hit.u * g.v1.xyz + hit.v * g.v2.xyz;
   sf.pError = hitPointError(b0, hit.u, hit.v, g.v0.xyz, g.v1.xyz, g.v2.xyz);  // spawn.glsl
 #ifdef CAUSTICA_INSTANCED
-  sf.pError += instancePointError(g, xf);
+  sf.pError += instancePointError(g, h.xf);
 #endif
   vec3 cr = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
   float crLen = length(cr);
@@ -56,16 +70,16 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   sf.ngFront = cr / crLen;
   sf.front = dot(dir, sf.ngFront) < 0.0;
   sf.ng = sf.front ? sf.ngFront : -sf.ngFront;
-  vec3 nsRaw = b0 * sn0 + hit.u * sn1 + hit.v * sn2;
+  vec3 nsRaw = b0 * h.n0 + hit.u * h.n1 + hit.v * h.n2;
   float nsLen = length(nsRaw);
   vec3 ns = nsLen > 1.0e-12 ? nsRaw / nsLen : sf.ngFront;
   if (dot(ns, sf.ngFront) < 0.0) ns = -ns;
-  sf.uv = b0 * st0 + hit.u * st1 + hit.v * st2;
+  sf.uv = b0 * h.t0 + hit.u * h.t1 + hit.v * h.t2;
   sf.color = vec4(1.0);  // exactly white where the scene has no colours (also under --all-features)
 #if defined(CAUSTICA_VERTEX_COLORS) && defined(CAUSTICA_TRISHADE_COLORS)
   vec4 sc0, sc1, sc2;
 #ifdef CAUSTICA_INSTANCED
-  instanceColors(hit.tri, xf, sc0, sc1, sc2);
+  instanceColors(hit.tri, h.xf, sc0, sc1, sc2);
 #else
   triColors(hit.tri, sc0, sc1, sc2);
 #endif
@@ -78,7 +92,7 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   if (normalMapped) {
     vec4 tt0, tt1, tt2;
 #ifdef CAUSTICA_INSTANCED
-    instanceTangents(hit.tri, xf, tt0, tt1, tt2);
+    instanceTangents(hit.tri, h.xf, tt0, tt1, tt2);
 #else
     triTangents(hit.tri, tt0, tt1, tt2);
 #endif
@@ -91,16 +105,22 @@ bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
   vec3 nc = ns;  // KHR_materials_clearcoat: the base's normal map does not apply to the coat
 #ifdef CAUSTICA_TEXTURES
   if (normalMapped)
-    nc = applyNormalMapTexture(sf.m.tex3.z, sf.m.coat.z, nc, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2,
+    nc = applyNormalMapTexture(sf.m.tex3.z, sf.m.coat.z, nc, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2,
                                tangent);
 #endif
   sf.nc = sf.front ? nc : -nc;
 #endif
 #ifdef CAUSTICA_TEXTURES
-  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, st0, st1, st2, tangent);
+  if (normalMapped) ns = applyNormalMap(sf.m, ns, sf.uv, g.v0.xyz, g.v1.xyz, g.v2.xyz, h.t0, h.t1, h.t2, tangent);
 #endif
   sf.ns = sf.front ? ns : -ns;
   return true;
+}
+
+// The surface at closest hit `hit` of a ray along unit direction dir (surfaceOn of its hitTriangle).
+bool surfaceAt(Hit hit, vec3 dir, bool normalMapped, out Surface sf) {
+  HitTriangle h = hitTriangle(hit);
+  return surfaceOn(hit, h, dir, normalMapped, sf);
 }
 
 // Whether the surface emits towards the ray (the front face, or both faces when double-sided).

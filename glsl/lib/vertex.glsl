@@ -3,6 +3,11 @@
 // here; other light kinds call the same two functions). Needs microfacet.glsl, lights.glsl, spawn.glsl,
 // traverse.glsl and, with CAUSTICA_CASTERS, casters.glsl (the Lambertian lobe's mixture pdf).
 
+#ifdef CAUSTICA_MANIFOLD
+LightSample gManifoldLight;     // the emitter sample of this vertex's next-event estimate (sampleEmitterLight),
+bool gManifoldLightOk = false;  // which manifold NEE joins to the vertex through a caster (path_manifold.glsl)
+#endif
+
 struct Vertex {
   Bsdf bsdf;        // the lobe chosen at this vertex (never a delta lobe)
   vec3 p;           // hit point (world space)
@@ -79,7 +84,12 @@ vec3 sampleEmitterLight(Vertex v, inout uvec4 rng, inout uint shadowRays) {
   return vec3(0.0 * uSelect * uTri.x);
 #else
   LightSample ls;
-  if (!sampleLight(v.p, v.ns, rand01(rng), rand2(rng), ls)) return vec3(0.0);
+  bool sampled = sampleLight(v.p, v.ns, rand01(rng), rand2(rng), ls);
+#ifdef CAUSTICA_MANIFOLD
+  gManifoldLight = ls;  // manifold NEE joins the same light sample to x through a caster
+  gManifoldLightOk = sampled;
+#endif
+  if (!sampled) return vec3(0.0);
   vec3 toLight = ls.p - v.p;
   float dist2 = dot(toLight, toLight);
   float dist = sqrt(dist2);

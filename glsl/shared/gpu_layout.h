@@ -46,6 +46,11 @@ using uint = std::uint32_t;
 #define CAUSTICA_TEXUNIT_TEX_INFO 8    // texture unit: buffer texture (rgba32ui) over the same buffer, 3 texels per TexInfo
 #define CAUSTICA_TEXUNIT_TRI_SHADE 9   // texture unit: buffer texture (rgb32ui) over the TriShade buffer (unless split), 3 words per texel
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
+#define CAUSTICA_TEXUNIT_CELL_KEYS 10   // texture unit: buffer texture (rgba32ui) over the caustic cell table's keys (manifold NEE)
+#define CAUSTICA_TEXUNIT_CELLS 11       // texture unit: buffer texture (rgba32ui) over its CausticCell slots
+#define CAUSTICA_BINDING_CELL_KEYS 0    // caustic_photons.comp only: SSBO of the cell table's keys (atomic compare-and-swap)
+#define CAUSTICA_BINDING_CELLS 1        // caustic_photons.comp only: SSBO of CausticCell words (atomic adds)
+#define CAUSTICA_BINDING_CELL_DROPS 2   // caustic_photons.comp only: SSBO: photons whose cell found no free slot
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
 #define CAUSTICA_BINDING_PUNCTUAL 4   // UBO: PunctualParams (KHR_lights_punctual; a UBO, not a ninth SSBO)
@@ -278,11 +283,26 @@ struct FrameParams {
 // A refractive caster is aimed at only from points that see it overlap the lights (within a margin):
 // the shadow side, where its caustic falls. Mirrors reflect light anywhere and are always aimed at.
 struct CasterParams {
-  uvec4 count;                            // x: spheres in use (0..CAUSTICA_MAX_CASTERS); y: bit i set = sphere i refracts; zw unused
+  uvec4 count;                            // x: spheres in use (0..CAUSTICA_MAX_CASTERS); y: bit i set = sphere i refracts;
+                                          // z: buckets of the caustic cell table - 1 (a power of 2 minus 1; manifold NEE,
+                                          // caustic_cells.glsl), 0: no table; w unused
   vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians); zw unused
   vec4 lights;                            // xyz: centre, w: radius of a sphere around every emitter (world space)
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
 };
+
+// The caustic cell table of manifold NEE (glsl/lib/caustic_cells.glsl, app/gpu/caustic_cells.h): a hash
+// table of receiver cells, each caster's cubes of kCellPerRadius times its radius, keyed by caster and
+// cell. Buckets of 4 keys (one uvec4 each; key 0: empty); each slot's CausticCell holds what the
+// caster's photons brought there (uint words, written with atomics by caustic_photons.comp): their
+// count and the sum of their directions back towards the caster's last vertex, each a unit vector
+// times kCellDirScale rounded (int bits).
+struct CausticCell {
+  uint count;
+  uint dirX, dirY, dirZ;
+};
+CAUSTICA_CONST float kCellDirScale = 1024.0;
+CAUSTICA_CONST float kCellPerRadius = 0.125;  // a cell's side over its caster's bounding radius
 
 // The environment light (scene/environment.h; glsl/lib/environment.glsl), std140. Its texels and
 // CDFs live in two textures (CAUSTICA_TEXUNIT_ENV_*): no ninth SSBO.
@@ -340,6 +360,7 @@ static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
 static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
+static_assert(sizeof(CausticCell) == 16, "CausticCell must be 16 bytes (one rgba32ui texel)");
 static_assert(sizeof(LightNode) == 64, "LightNode must be 64 bytes (std430)");
 }  // namespace caustica::gpu
 #endif

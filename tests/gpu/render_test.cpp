@@ -31,7 +31,8 @@ struct BlockStats {
 
 BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
                       int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth,
-                      float casterProbability = 0.5f, std::vector<std::string>* defines = nullptr) {
+                      float casterProbability = 0.5f, std::vector<std::string>* defines = nullptr,
+                      bool manifold = false) {
   BlockStats b;
   b.blocksX = w / block;
   b.blocksY = h / block;
@@ -41,6 +42,7 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
     RenderSettings settings = smallSettings(w, h, integrator, seedBase + r);
     settings.maxDepth = maxDepth;
     settings.casterProbability = casterProbability;
+    settings.manifold = manifold;
     RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     if (defines) *defines = res.defines;
@@ -67,11 +69,12 @@ bool longTests() { return std::getenv("CAUSTICA_LONG_TESTS") != nullptr; }
 
 // Two estimators must agree within noise: per block, |difference| within 4.5 standard errors (plus a
 // small relative slack for the variance estimate's own noise); the image and its quadrants within 4.5
-// standard errors of their own.
-void checkBlocksAgree(const std::string& what, const BlockStats& a, const BlockStats& b) {
+// standard errors of their own. Without `blocks` only the image and its quadrants (for an estimator
+// that finds a small lamp in too few of a block's samples to estimate its variance).
+void checkBlocksAgree(const std::string& what, const BlockStats& a, const BlockStats& b, bool blocks = true) {
   int bad = 0;
   std::string worst;
-  for (size_t i = 0; i < a.mean.size(); ++i) {
+  for (size_t i = 0; i < a.mean.size() && blocks; ++i) {
     double diff = std::abs(a.mean[i] - b.mean[i]);
     double tol = 4.5 * std::sqrt(a.var[i] + b.var[i]) + 0.01 * std::max(a.mean[i], b.mean[i]) + 1e-4;
     if (diff > tol) {
@@ -333,6 +336,81 @@ TEST_CASE("mis aiming at the glass ball (caustic casters) matches naive and find
       }
   INFO("variance around the focus: with casters ", varAimed, ", without ", varPlain);
   CHECK(varAimed < 0.5 * varPlain);
+}
+
+namespace {
+
+// Mean and variance of the mean of the blocks [bx0, bx1) x [by0, by1) of `s` (all channels).
+std::pair<double, double> blockRegion(const BlockStats& s, int bx0, int by0, int bx1, int by1) {
+  double m = 0.0, v = 0.0;
+  const double n = 3.0 * (bx1 - bx0) * (by1 - by0);
+  for (int by = by0; by < by1; ++by)
+    for (int bx = bx0; bx < bx1; ++bx)
+      for (int ch = 0; ch < 3; ++ch) {
+        const size_t i = (static_cast<size_t>(by) * s.blocksX + bx) * 3 + ch;
+        m += s.mean[i] / n;
+        v += s.var[i] / (n * n);  // disjoint pixels: independent block means
+      }
+  return {m, v};
+}
+
+// Manifold NEE against naive and against mis without it on `scene`: blocks, image and quadrants
+// (checkBlocksAgree), and the caustic region [bx0, bx1) x [by0, by1) of blocks within 4.5 standard
+// errors; naiveBlocks: naive's blocks too. Returns the three estimates' BlockStats (naive, mis, manifold).
+std::array<BlockStats, 3> checkManifoldAgrees(const std::string& what, const Scene& scene, int w, int h, int block,
+                                             int sppNaive, int sppMis, int bx0, int by0, int bx1, int by1,
+                                             bool naiveBlocks = true) {
+  const Camera& cam = scene.cameras[0];
+  const int renders = 8;
+  std::uint64_t nonFinite = 0;
+  std::vector<std::string> misDefines, manifoldDefines;
+  BlockStats naive = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 700, &nonFinite, 32);
+  BlockStats mis =
+      blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 800, &nonFinite, 32, 0.5f, &misDefines);
+  BlockStats manifold = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 900, &nonFinite, 32, 0.5f,
+                                   &manifoldDefines, true);
+  REQUIRE_FALSE(hasDefine(misDefines, "CAUSTICA_MANIFOLD"));
+  REQUIRE(hasDefine(manifoldDefines, "CAUSTICA_MANIFOLD"));
+  checkBlocksAgree(what + ", naive against manifold NEE", naive, manifold, naiveBlocks);
+  checkBlocksAgree(what + ", mis against manifold NEE", mis, manifold);
+  CHECK(nonFinite == 0);
+  const auto [mm, vm] = blockRegion(manifold, bx0, by0, bx1, by1);
+  for (const BlockStats* other : {&naive, &mis}) {
+    const auto [mo, vo] = blockRegion(*other, bx0, by0, bx1, by1);
+    const std::string name = other == &naive ? "naive " : "mis ";
+    const double se = std::sqrt(vm + vo);
+    INFO(what, ", caustic region: ", name, mo, " manifold ", mm,
+         ", standard error of the difference ", se, " (", 100.0 * se / mm, " % of the mean)");
+    CHECK(std::abs(mo - mm) <= 4.5 * se);
+    MESSAGE(what, ", caustic region, ", name, mo, " manifold ", mm,
+            ": the smallest bias this run detects ", 100.0 * 4.5 * se / mm, " %");
+  }
+  return {naive, mis, manifold};
+}
+
+}  // namespace
+
+TEST_CASE("manifold NEE matches naive and mis: glass ball caustic") {
+  Scene scene = causticScene(0.0f);
+  const int n = 32, block = 4;
+  glm::ivec2 c = project(scene.cameras[0], glm::vec3(0.0f), n) / block;  // the focus under the ball
+  const int f = longTests() ? 4 : 1;
+  auto st = checkManifoldAgrees("glass ball", scene, n, n, block, 256 * f, 64 * f, c.x - 1, c.y - 1, c.x + 2, c.y + 2);
+  // Same samples per pixel: the variance of the caustic region's mean compares per sample.
+  const double vMis = blockRegion(st[1], c.x - 1, c.y - 1, c.x + 2, c.y + 2).second;
+  const double vManifold = blockRegion(st[2], c.x - 1, c.y - 1, c.x + 2, c.y + 2).second;
+  INFO("variance of the caustic region's mean: mis ", vMis, ", manifold ", vManifold);
+  CHECK(vManifold < 0.5 * vMis);
+}
+
+TEST_CASE("manifold NEE matches naive and mis: mirror-caustic") {
+  Scene scene = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
+  scene.cameras = {sceneCamera(scene)};
+  const int f = longTests() ? 4 : 1;
+  // bench/scenes.json's caustic region [0.30, 0.50, 0.70, 0.85] in blocks of 4 of a 40 x 40 image.
+  // Naive reaches the small lamp in too few samples per block (some blocks none: no variance to test
+  // against); it is compared on the image, its quadrants and the caustic region.
+  checkManifoldAgrees("mirror-caustic", scene, 40, 40, 4, 128 * f, 32 * f, 3, 5, 7, 8, false);
 }
 
 TEST_CASE("rgb and spectral dispersion agree in mean brightness, and spread the caustic into colours") {

@@ -202,6 +202,7 @@ TEST_CASE("shader features: detection from the materials some triangle uses and 
   CHECK(detect(s).has("CAUSTICA_MIS"));
   CHECK_FALSE(detect(s).has("CAUSTICA_NO_EMITTERS"));
   CHECK(detect(s).has("CAUSTICA_CASTERS"));  // the small glass square is a caustic caster
+  CHECK(detect(s).has("CAUSTICA_MANIFOLD"));  // a caster and an emitter: manifold NEE's scene side
 
   s.background = parseBackground("0.2");
   CHECK(detect(s).has("CAUSTICA_ENV"));
@@ -284,6 +285,17 @@ TEST_CASE("shader features: a variant compiles the rows its mode reads, its sett
         "CAUSTICA_SHEEN CAUSTICA_FACTOR_TEXTURES CAUSTICA_TRANSPARENT");
 
   s = path;
+  // Manifold NEE only when asked and only where the scene has a caster and an emitter: a scene without
+  // casters compiles the same variant with --manifold on as off (it pays nothing).
+  s = path;
+  s.manifold = true;
+  CHECK(variantFeatures(rows({"CAUSTICA_MIS"}), s) == variantFeatures(rows({"CAUSTICA_MIS"}), path));
+  const FeatureSet caustic = rows({"CAUSTICA_GLASS", "CAUSTICA_MIS", "CAUSTICA_CASTERS", "CAUSTICA_MANIFOLD"});
+  CHECK(joined(variantFeatures(caustic, s).defines()) == "CAUSTICA_GLASS CAUSTICA_MIS CAUSTICA_CASTERS CAUSTICA_MANIFOLD");
+  CHECK_FALSE(variantFeatures(caustic, path).has("CAUSTICA_MANIFOLD"));  // off by default
+  s.integrator = Integrator::Naive;
+  CHECK_FALSE(variantFeatures(caustic, s).has("CAUSTICA_MANIFOLD"));  // needs mis
+
   s.mode = RenderMode::Whitted;  // scene and image rows only; --all-features is the path tracer's
   s.allFeatures = true;
   s.dispersion = DispersionMode::Spectral;

@@ -114,6 +114,16 @@ TEST_CASE("shards merged equal one render: Cornell box with glass, 1 to 16 shard
   checkShardsEqualOne(scene, rs, 21, {1, 2, 3, 5, 16});
 }
 
+TEST_CASE("shards merged equal one render: manifold NEE (its photon pass the same in every shard), 3 shards of 12 spp") {
+  const Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
+  RenderSettings rs;
+  rs.width = 24;
+  rs.height = 18;
+  rs.seed = 7;
+  rs.manifold = true;
+  checkShardsEqualOne(scene, rs, 12, {3});
+}
+
 TEST_CASE("shards merged equal one render: a transparent background's coverage, 64 spp in 4 shards") {
   Scene scene = loadScene(sourcePath("assets/scenes/sun-glass.gltf"));
   scene.background.kind = Background::Kind::Transparent;

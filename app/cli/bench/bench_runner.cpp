@@ -69,11 +69,11 @@ class BenchRunner {
     outDir_ = opts.get("--out", "bench-out");
     cacheDir_ = opts.get("--cache", defaultReferenceCacheDir());
     for (const auto& name : splitList(opts.get("--integrators", "naive,mis")))
-      integrators_.push_back(parseIntegrator(name));
-    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis");
+      integrators_.push_back(parseEstimator(name));
+    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis, manifold");
     // --adaptive: the integrators that also get an adaptive run (default mis; "none" for none).
     for (const auto& name : splitList(opts.get("--adaptive", "mis")))
-      if (name != "none") adaptiveIntegrators_.push_back(parseIntegrator(name));
+      if (name != "none") adaptiveIntegrators_.push_back(parseEstimator(name));
     for (const auto& name : splitList(opts.get("--dispersion", "rgb,spectral")))
       dispersions_.push_back(parseDispersionMode(name));
     if (dispersions_.empty()) throw Error("option --dispersion needs at least one of rgb, spectral");
@@ -168,10 +168,11 @@ class BenchRunner {
         printAdaptiveBound(renderer, run, name, mode, ref);
         continue;
       }
-      for (Integrator integrator : integrators_) {  // the cache left the renderer in the reference's settings
+      for (const Estimator& integrator : integrators_) {  // the cache left the renderer in the reference's settings
         RenderSettings run = settings;
         run.dispersion = mode;
-        run.integrator = integrator;
+        run.integrator = integrator.integrator;
+        run.manifold = integrator.manifold;
         renderer.apply(run);
         results.push_back(measure(renderer, name, ref, caustic, false));
         if (std::find(adaptiveIntegrators_.begin(), adaptiveIntegrators_.end(), integrator) !=
@@ -383,7 +384,18 @@ class BenchRunner {
   BenchSetup setup_;  // GL renderer, backend and --max-seconds
   int referenceSpp_ = kDefaultReferenceSpp;
   std::string outDir_, cacheDir_;
-  std::vector<Integrator> integrators_, adaptiveIntegrators_;
+  // An estimator of --integrators: naive, mis, or manifold (mis with manifold NEE); mis takes --manifold.
+  struct Estimator {
+    Integrator integrator;
+    bool manifold;
+    bool operator==(const Estimator& o) const { return integrator == o.integrator && manifold == o.manifold; }
+  };
+  Estimator parseEstimator(const std::string& name) const {
+    if (name == "manifold") return {Integrator::Mis, true};
+    Integrator i = parseIntegrator(name);
+    return {i, i == Integrator::Mis && opts_.get("--manifold", "off") == "on"};
+  }
+  std::vector<Estimator> integrators_, adaptiveIntegrators_;
   std::vector<DispersionMode> dispersions_;
   std::map<std::string, BenchSceneInfo> sceneInfo_;
   bool boundHeader_ = false;    // --adaptive-bound: the table's header is printed

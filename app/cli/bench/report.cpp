@@ -60,6 +60,7 @@ std::string estimatorName(const RenderSettings& settings, bool sceneHasCasters) 
   if (settings.integrator == Integrator::Mis && sceneHasCasters &&
       settings.casterProbability != RenderSettings{}.casterProbability)
     name += formatDouble(" casters=%g", settings.casterProbability);
+  if (settings.integrator == Integrator::Mis && sceneHasCasters && settings.manifold) name += " manifold";
   return name;
 }
 

@@ -1,0 +1,109 @@
+// caustic_photons.comp — the caustic photon pass of manifold NEE: photons leave the emitters towards
+// each caster, follow its specular chain (a glass caster: in and out; a mirror caster: one reflection)
+// and land on a diffuse surface, where each adds itself and its direction back towards the caster to
+// its cell of the caustic cell table (caustic_cells.glsl). Integer atomics only, and a key's slot is
+// found by compare-and-swap in a fixed order of 8 slots, so the table holds the same cells and sums
+// whatever order the photons run in, as long as no photon is dropped (app/gpu/caustic_cells.h).
+#define CAUSTICA_PHOTON_PASS
+#include "lib/bindings.glsl"
+#include "lib/rng.glsl"
+#include "lib/sampling.glsl"
+#include "lib/spawn.glsl"
+#include "lib/intersect.glsl"
+#include "lib/traverse.glsl"
+#include "lib/textures.glsl"
+#include "lib/spectral.glsl"
+#include "lib/microfacet.glsl"
+#include "lib/materials.glsl"
+#include "lib/lights.glsl"
+#include "lib/casters.glsl"
+#include "lib/surface.glsl"
+#include "lib/caustic_cells.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(std430, binding = CAUSTICA_BINDING_CELL_KEYS) buffer CellKeys { uint keyWords[]; };  // 4 per bucket
+layout(std430, binding = CAUSTICA_BINDING_CELLS) buffer Cells { uint cellWords[]; };         // 4 per slot
+layout(std430, binding = CAUSTICA_BINDING_CELL_DROPS) buffer CellDrops { uint drops; };      // photons without a slot
+
+layout(location = 0) uniform uint photons;  // photons per caster (gl_GlobalInvocationID.x below it)
+
+// Follows photon `index` of caster `caster` from an emitter through the caster's chain to a diffuse
+// surface: its landing point and the unit direction from there back to the chain's last vertex.
+bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
+  landing = back = vec3(0.0);
+  uvec4 rng = rngSeed(index, caster, 0x9e3779b9u);
+  vec4 sphere = casters.sphere[caster];
+  LightSample ls;
+  if (!sampleLight(sphere.xyz, vec3(0.0), rand01(rng), rand2(rng), ls)) return false;
+  vec3 axis;
+  float omc;
+  vec3 facing = ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n;
+  if (!casterCone(ls.p, facing, sphere, axis, omc)) return false;
+  vec3 dir = sampleUniformCone(axis, omc, rand2(rng));
+  float side = dot(dir, ls.n);
+  if (!(side > 0.0 || ls.twoSided)) return false;
+  vec3 org = offsetRayOrigin(ls.p, ls.pError, side > 0.0 ? ls.n : -ls.n);
+  bool refractive = (casters.count.y & (1u << caster)) != 0u;
+  uint events = refractive ? 2u : 1u;
+  vec3 last = ls.p;
+  for (uint k = 0u; k <= events; ++k) {
+    Hit hit;
+    if (!traceClosest(org, dir, 3.0e38, hit)) return false;
+    Surface sf;
+    if (!surfaceAt(hit, dir, false, sf)) return false;
+    vec2 metalRough = materialMetalRough(sf.m, sf.uv);
+    if (k == events) {  // the receiver: a surface with a Lambertian part
+      if (!((1.0 - metalRough.x) * (1.0 - sf.m.params.z) > 0.0)) return false;
+      landing = sf.p;
+      back = normalize(last - sf.p);
+      return true;
+    }
+    vec3 d = sf.p - sphere.xyz;
+    bool isSmooth = metalRough.y * metalRough.y < kDeltaAlpha;
+    if (dot(d, d) > sphere.w * sphere.w || !isSmooth) return false;
+    vec3 next;
+    if (refractive) {
+      float eta = sf.front ? sf.m.params.w : 1.0 / sf.m.params.w;
+      if (!((1.0 - metalRough.x) * sf.m.params.z > 0.0) || !refractDir(dir, sf.ns, 1.0 / eta, next) ||
+          dot(next, sf.ng) >= 0.0)
+        return false;
+      org = offsetRayOrigin(sf.p, sf.pError, -sf.ng);
+    } else {
+      next = reflect(dir, sf.ns);
+      if (!(metalRough.x > 0.0) || dot(next, sf.ng) <= 0.0) return false;
+      org = offsetRayOrigin(sf.p, sf.pError, sf.ng);
+    }
+    dir = next;
+    last = sf.p;
+  }
+  return false;
+}
+
+void main() {
+  uint index = gl_GlobalInvocationID.x, caster = gl_GlobalInvocationID.y;
+  if (index >= photons || caster >= casters.count.x) return;
+  vec3 landing, back;
+  if (!tracePhoton(caster, index, landing, back)) return;
+  uint key = casterCellKey(caster, landing);
+  if (key == 0u) return;
+  // The key's slot: the first of its 8 slots (first bucket, then second) that holds it or was empty. A
+  // slot once keyed keeps its key, so every photon of a cell finds the same slot.
+  uvec2 b = cellBuckets(key);
+  int slot = -1;
+  for (uint j = 0u; j < 8u && slot < 0; ++j) {
+    uint s = 4u * (j < 4u ? b.x : b.y) + (j & 3u);
+    uint prev = atomicCompSwap(keyWords[s], 0u, key);
+    if (prev == 0u || prev == key) slot = int(s);
+  }
+  if (slot < 0) {
+    atomicAdd(drops, 1u);
+    return;
+  }
+  ivec3 d = ivec3(round(back * kCellDirScale));
+  uint w = 4u * uint(slot);
+  atomicAdd(cellWords[w], 1u);
+  atomicAdd(cellWords[w + 1u], uint(d.x));
+  atomicAdd(cellWords[w + 2u], uint(d.y));
+  atomicAdd(cellWords[w + 3u], uint(d.z));
+}

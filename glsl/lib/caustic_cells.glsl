@@ -1,0 +1,45 @@
+// caustic_cells.glsl — the caustic cell table (CausticCell in gpu_layout.h): for each caster, the cells
+// (cubes of kCellPerRadius times its radius) that its caustic photons reached (caustic_photons.comp),
+// with their count and the direction they came from. Manifold NEE joins light through a caster only
+// from its cells and starts its Newton steps from the cell's direction (path_manifold.glsl). A hash
+// table of buckets of 4 keys; a key lives in one of two buckets, so a lookup reads two buckets and one
+// slot, without a loop. Needs rng.glsl (pcg4d) and casters.glsl (the CasterParams block).
+
+// The key of the cell of caster `caster` holding p: 3 bits of caster, 10 + 9 + 10 bits of the cell's
+// coordinates about the caster's centre (x, z within +-512 cells, y within +-256); 0 (no key) outside.
+uint casterCellKey(uint caster, vec3 p) {
+  vec4 sphere = casters.sphere[caster];
+  vec3 c = floor((p - sphere.xyz) / (kCellPerRadius * sphere.w)) + vec3(512.0, 256.0, 512.0);
+  if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(1024.0, 512.0, 1024.0)))) return 0u;
+  uvec3 u = uvec3(c);
+  return caster << 29 | u.x << 19 | u.y << 10 | u.z;
+}
+
+// The key's two buckets (indices, under the table's mask casters.count.z).
+uvec2 cellBuckets(uint key) {
+  uvec4 h = pcg4d(uvec4(key, 0x2545f491u, 0x9e3779b9u, key ^ 0x85ebca6bu));
+  return uvec2(h.x, h.y) & casters.count.z;
+}
+
+#ifndef CAUSTICA_PHOTON_PASS
+layout(binding = CAUSTICA_TEXUNIT_CELL_KEYS) uniform usamplerBuffer cellKeys;  // 4 keys per bucket
+layout(binding = CAUSTICA_TEXUNIT_CELLS) uniform usamplerBuffer cellSlots;     // CausticCell per slot
+
+// What the photons of caster `caster` brought to the cell at p: count (x) and summed direction (yzw,
+// int bits); 0 where none came or there is no table.
+uvec4 casterCell(uint caster, vec3 p) {
+  uint key = casterCellKey(caster, p);
+  if (key == 0u || casters.count.z == 0u) return uvec4(0u);
+  uvec2 b = cellBuckets(key);
+  uvec4 k1 = texelFetch(cellKeys, int(b.x)), k2 = texelFetch(cellKeys, int(b.y));
+  bvec4 m1 = equal(k1, uvec4(key)), m2 = equal(k2, uvec4(key));
+  int slot = -1;
+  for (int j = 3; j >= 0; --j) {  // unrolled: straight-line selects
+    if (m2[j]) slot = int(4u * b.y) + j;
+  }
+  for (int j = 3; j >= 0; --j) {
+    if (m1[j]) slot = int(4u * b.x) + j;
+  }
+  return slot < 0 ? uvec4(0u) : texelFetch(cellSlots, slot);
+}
+#endif
