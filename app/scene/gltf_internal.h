@@ -206,6 +206,14 @@ class SceneBuilder {
   // Reads every animation (for Scene::animations) and samples the chosen one(s) at pose_.time into
   // animatedTrs_ and animatedWeights_; names the chosen ones in Scene::animationsPlayed.
   void readAnimations();
+  // readAnimations' steps, in order (gltf_animation.cpp).
+  std::vector<bool> chooseAnimations();
+  KeyframeCurve curveKeys(const tinygltf::AnimationSampler& sm, const std::string& sat,
+                          std::map<int, std::vector<double>>& times);
+  bool readCurveValues(const tinygltf::AnimationChannel& ch, const tinygltf::AnimationSampler& sm, const std::string& cat,
+                       const std::string& sat, KeyframeCurve& curve);
+  void applyAnimatedValue(const tinygltf::AnimationChannel& ch, const std::string& sat, const std::vector<double>& v,
+                          std::set<int>& warnedMatrix);
   // The node's morph-target weights at the pose (animated, else node.weights, else mesh.weights).
   std::vector<double> nodeWeights(int nodeIndex, int mesh, const std::string& at);
   // World matrices of every node (needed by skins, whose joints may lie anywhere in the tree).
