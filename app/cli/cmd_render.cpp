@@ -195,9 +195,8 @@ int renderFrames(const Options& opts, const std::string& pattern, const RenderBu
   return 0;
 }
 
-}  // namespace
-
-int cmdRender(const std::vector<std::string>& args) {
+// The options of `caustica render`, the scene options last.
+std::vector<OptionSpec> renderOptionSpecs() {
   std::vector<OptionSpec> specs = {
       {"--output", "-o", "FILE", "output image: .png (tone-mapped sRGB), .exr or .pfm (linear) (default caustica.png)"},
       {"--spp", "", "N", "samples per pixel, a cap (default 64; with --time or --target-error: 65536)"},
@@ -229,17 +228,12 @@ int cmdRender(const std::vector<std::string>& args) {
        "OUTPUT-STEM.NAME.pfm (raw: the output's format) beside it; with --shard: caustica merge --aov writes them"},
   };
   for (auto& s : sceneOptionSpecs()) specs.push_back(s);
-  Options opts("caustica render [SCENE] [options]",
-               "Renders SCENE (a .gltf/.glb file or a bundled scene name; default cornell-glass) headless and\n"
-               "writes the mean radiance of each pixel. Linear outputs are not tone-mapped or clamped.\n"
-               "Ctrl-C (SIGINT) or SIGTERM finishes the current pass, writes the image so far and a\n"
-               "checkpoint, and exits with status 4; a second Ctrl-C aborts at once.",
-               specs);
-  if (!opts.parse(args)) return 0;
-  bool quiet = opts.has("--quiet");
-  std::string out = opts.get("--output", "caustica.png");
-  const bool sharded = opts.has("--shard");
-  // fail before any work
+  return specs;
+}
+
+// Refuses an output name or an option the render mode (--frames, --shard or one image) cannot take,
+// before any work.
+void checkOutputForMode(const Options& opts, const std::string& out, bool sharded) {
   if (opts.has("--frames")) {
     // checked by renderFrames
   } else if (sharded) {
@@ -263,6 +257,10 @@ int cmdRender(const std::vector<std::string>& args) {
   } else {
     checkImageExtension(out);
   }
+}
+
+// --time, --target-error, --uniform and --spp: when the render stops.
+RenderBudget parseBudget(const Options& opts) {
   RenderBudget budget;
   budget.seconds = opts.getDouble("--time", 0.0);
   if (opts.has("--time") && !(budget.seconds > 0.0 && budget.seconds < 1e9))
@@ -275,6 +273,125 @@ int cmdRender(const std::vector<std::string>& args) {
   const bool openEnded = opts.has("--time") || opts.has("--target-error");
   int spp = opts.getInt("--spp", openEnded ? 65536 : 64, 1, 1 << 24);
   budget.maxSpp = spp;
+  return budget;
+}
+
+// Refuses, before any work, an output file that could not be written.
+void checkOutputsWritable(const std::string& out, const std::string& checkpointFile, const std::vector<Aov>& aovs,
+                          bool sharded) {
+  checkWritableFile(out, "output");
+  checkWritableFile(checkpointFile, "checkpoint");
+  if (!sharded)  // a shard writes its partial only; merge writes the AOVs
+    for (const std::string& f : aovFiles(out, aovs)) checkWritableFile(f, "--aov");
+}
+
+// The checkpoint --resume names (auto: RESUMEPATH, this render's own, if it exists); none without --resume.
+// A bad file fails before any work; with auto, a missing one starts the render (a first run).
+std::optional<Checkpoint> readResume(const Options& opts, const std::string& resumePath, bool quiet) {
+  std::optional<Checkpoint> resumeFrom;
+  const bool resumeAuto = opts.get("--resume", "") == "auto";
+  if (opts.has("--resume") && (!resumeAuto || std::filesystem::exists(resumePath))) resumeFrom = readCheckpoint(resumePath);
+  else if (resumeAuto) note(quiet, "--resume auto: no " + resumePath + " yet, starting the render");
+  return resumeFrom;
+}
+
+// Refuses what the loaded scene's settings cannot give: alpha in a PFM, features without the path tracer.
+void checkSceneForOutput(const LoadedScene& ls, const std::string& out, bool features, bool denoise) {
+  if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
+    throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
+  if (features && !renderModeSpec(ls.settings.render.mode).pathTracer)
+    throw Error(std::string(denoise ? "--denoise" : "--aov") + " needs the path tracer (--mode path), not --mode " +
+                renderModeName(ls.settings.render.mode));
+}
+
+// Refuses a checkpoint of another scene, other settings or another shard.
+void checkResumable(const Checkpoint& from, const std::string& resumePath, std::uint64_t sceneHash,
+                    const std::string& identity, const std::optional<SampleShare>& share) {
+  std::string diff = checkpointMismatch(from, sceneHash, identity);
+  if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
+  if (from.shard && !share)
+    throw Error(resumePath + ": it is the partial of " + describeShare(*from.shard) + " of " +
+                std::to_string(from.shard->total) + " spp: continue it with --shard " +
+                std::to_string(from.shard->index) + "/" + std::to_string(from.shard->count) + " --spp " +
+                std::to_string(from.shard->total) + " (or merge the shards with caustica merge)");
+  if (share && !from.shard)
+    throw Error(resumePath + ": it is the checkpoint of a whole render, not of a shard: --shard cannot continue it");
+  if (share && *from.shard != *share)
+    throw Error(resumePath + ": cannot resume another shard: the file holds " + describeShare(*from.shard) +
+                " of " + std::to_string(from.shard->total) + " spp, this render is " + describeShare(*share) +
+                " of " + std::to_string(share->total) + " spp");
+}
+
+// What is about to be rendered: the scene, its features, the image size, samples and estimator.
+std::string renderSummary(const Renderer& renderer, const Scene& scene, const RenderSettings& settings, int spp,
+                          const std::optional<SampleShare>& share) {
+  return scene.path + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
+         std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
+         renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
+         std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
+         (share ? describeShare(*share) + ", " : std::string()) +
+         (renderModeSpec(settings.mode).pathTracer ? integratorName(settings.integrator) : renderModeName(settings.mode));
+}
+
+// The render's time, sample and ray rates, and non-finite sample count, as one line.
+std::string speedLine(const RenderStats& st, double total) {
+  char line[256];
+  std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s, non-finite samples: %llu", total,
+                double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
+  return line;
+}
+
+// Prints the render statistics as JSON and writes them to --stats FILE (atomically) when asked.
+void writeStats(Renderer& renderer, const BudgetResult& result, const RenderBudget& budget, const std::string& statsFile,
+                bool quiet) {
+  const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);
+  note(quiet, "stats " + json);
+  if (!statsFile.empty())
+    writeFileAtomically(statsFile, ".tmp", [&](const std::string& tmp) {
+      std::ofstream f(tmp, std::ios::trunc);
+      f << json << "\n";
+      f.close();
+      if (!f) throw Error(tmp + ": cannot write the statistics");
+    });
+}
+
+// Saves what an interrupted render has and says so on stderr.
+void reportInterrupted(const std::function<void()>& saveCheckpoint, const std::string& checkpointFile,
+                       const std::optional<SampleShare>& share, int samples, int maxSpp, int spp, double total,
+                       const std::string& out) {
+  // Always said, even with --quiet: it explains the exit status.
+  std::string saved;
+  try {
+    saveCheckpoint();
+    saved = (share ? " " : " and checkpoint ") + checkpointFile + " (continue with --resume " + checkpointFile + ")";
+  } catch (const Error& e) {
+    saved = "; no checkpoint: " + std::string(e.what());
+  }
+  if (share)
+    std::fprintf(stderr, "caustica: interrupted at %d/%d samples of %s after %.0f s; wrote the partial%s\n",
+                 samples, maxSpp, describeShare(*share).c_str(), total, saved.c_str());
+  else
+    std::fprintf(stderr, "caustica: interrupted at %d/%d spp after %.0f s; wrote %s (partial)%s\n",
+                 samples, spp, total, out.c_str(), saved.c_str());
+}
+
+}  // namespace
+
+int cmdRender(const std::vector<std::string>& args) {
+  const std::vector<OptionSpec> specs = renderOptionSpecs();
+  Options opts("caustica render [SCENE] [options]",
+               "Renders SCENE (a .gltf/.glb file or a bundled scene name; default cornell-glass) headless and\n"
+               "writes the mean radiance of each pixel. Linear outputs are not tone-mapped or clamped.\n"
+               "Ctrl-C (SIGINT) or SIGTERM finishes the current pass, writes the image so far and a\n"
+               "checkpoint, and exits with status 4; a second Ctrl-C aborts at once.",
+               specs);
+  if (!opts.parse(args)) return 0;
+  bool quiet = opts.has("--quiet");
+  std::string out = opts.get("--output", "caustica.png");
+  const bool sharded = opts.has("--shard");
+  checkOutputForMode(opts, out, sharded);  // fail before any work
+  RenderBudget budget = parseBudget(opts);
+  int spp = budget.maxSpp;
   const std::string statsFile = opts.get("--stats", "");
   if (opts.has("--stats")) checkWritableFile(statsFile, "stats");
   Backend backend = parseBackend(opts.get("--backend", "auto"));
@@ -291,16 +408,9 @@ int cmdRender(const std::vector<std::string>& args) {
     share = shareOf(k, n, spp);
     budget.maxSpp = int(share->end - share->first);
   }
-  checkWritableFile(out, "output");
-  checkWritableFile(checkpointFile, "checkpoint");
-  if (!share)  // a shard writes its partial only; merge writes the AOVs
-    for (const std::string& f : aovFiles(out, aovs)) checkWritableFile(f, "--aov");
-  std::optional<Checkpoint> resumeFrom;
-  const bool resumeAuto = opts.get("--resume", "") == "auto";
-  const std::string resumePath = resumeAuto ? checkpointFile : opts.get("--resume", "");
-  // A bad file fails before any work; with auto, a missing one starts the render (a first run).
-  if (opts.has("--resume") && (!resumeAuto || std::filesystem::exists(resumePath))) resumeFrom = readCheckpoint(resumePath);
-  else if (resumeAuto) note(quiet, "--resume auto: no " + resumePath + " yet, starting the render");
+  checkOutputsWritable(out, checkpointFile, aovs, share.has_value());
+  const std::string resumePath = opts.get("--resume", "") == "auto" ? checkpointFile : opts.get("--resume", "");
+  const std::optional<Checkpoint> resumeFrom = readResume(opts, resumePath, quiet);
   // The feature buffers: for the denoiser and --aov, and kept going when the checkpoint has them.
   const bool features = denoise || aovsNeedFeatures(aovs) || (resumeFrom && resumeFrom->state.hasFeatures());
   if (resumeFrom && features && !resumeFrom->state.hasFeatures())
@@ -312,13 +422,9 @@ int cmdRender(const std::vector<std::string>& args) {
   LoadedScene ls = loadSceneForCli(opts, !quiet, 512);  // the scene with every image setting applied
   memTrace("scene loaded");
   const double parseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
-  if (ls.scene.background.kind == Background::Kind::Transparent && fileExtension(out) == ".pfm")
-    throw Error(out + ": PFM has no alpha channel: write .exr or .png with --background transparent");
+  checkSceneForOutput(ls, out, features, denoise);
   const RenderSettings& settings = ls.settings.render;
   const ToneMapSettings& tone = ls.settings.tone;
-  if (features && !renderModeSpec(settings.mode).pathTracer)
-    throw Error(std::string(denoise ? "--denoise" : "--aov") + " needs the path tracer (--mode path), not --mode " +
-                renderModeName(settings.mode));
   flattenForMode(ls.scene, settings.mode, opts, quiet);  // raster draws flat scenes (cli_common.h)
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
   const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
@@ -326,21 +432,7 @@ int cmdRender(const std::vector<std::string>& args) {
   if (share && renderModeSpec(settings.mode).samples == SampleRule::OneFrame)
     throw Error(std::string("--mode ") + renderModeName(settings.mode) +
                 " with --shard: it draws one deterministic frame, there are no samples to share");
-  if (resumeFrom) {
-    std::string diff = checkpointMismatch(*resumeFrom, sceneHash, identity);
-    if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
-    if (resumeFrom->shard && !share)
-      throw Error(resumePath + ": it is the partial of " + describeShare(*resumeFrom->shard) + " of " +
-                  std::to_string(resumeFrom->shard->total) + " spp: continue it with --shard " +
-                  std::to_string(resumeFrom->shard->index) + "/" + std::to_string(resumeFrom->shard->count) + " --spp " +
-                  std::to_string(resumeFrom->shard->total) + " (or merge the shards with caustica merge)");
-    if (share && !resumeFrom->shard)
-      throw Error(resumePath + ": it is the checkpoint of a whole render, not of a shard: --shard cannot continue it");
-    if (share && *resumeFrom->shard != *share)
-      throw Error(resumePath + ": cannot resume another shard: the file holds " + describeShare(*resumeFrom->shard) +
-                  " of " + std::to_string(resumeFrom->shard->total) + " spp, this render is " + describeShare(*share) +
-                  " of " + std::to_string(share->total) + " spp");
-  }
+  if (resumeFrom) checkResumable(*resumeFrom, resumePath, sceneHash, identity, share);
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);
   memTrace("context");
@@ -349,12 +441,7 @@ int cmdRender(const std::vector<std::string>& args) {
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
   renderer.setFeatureBuffers(features);
-  note(quiet, ls.scene.path + ": " + std::to_string(ls.scene.triangles.size()) + " triangles, " +
-                  std::to_string(renderer.gpuScene().emitterCount) + " emissive, features: " +
-                  renderer.sceneFeatures().describe() + "; " + std::to_string(settings.width) + "x" +
-                  std::to_string(settings.height) + ", " + std::to_string(spp) + " spp, " +
-                  (share ? describeShare(*share) + ", " : std::string()) +
-                  (renderModeSpec(settings.mode).pathTracer ? integratorName(settings.integrator) : renderModeName(settings.mode)));
+  note(quiet, renderSummary(renderer, ls.scene, settings, spp, share));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);
     note(quiet, "resumed " + resumePath + " at " + std::to_string(renderer.samplesPerPixel()) + " spp");
@@ -371,39 +458,12 @@ int cmdRender(const std::vector<std::string>& args) {
   memTrace("rendered");
   const bool complete = result.reason != StopReason::Interrupted;
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const RenderStats& st = renderer.stats();
-  char line[256];
-  std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s, non-finite samples: %llu", total,
-                double(st.primaryRays) / total, double(st.rays()) / total, static_cast<unsigned long long>(st.nonFinite));
-  note(quiet, line);
+  note(quiet, speedLine(renderer.stats(), total));
   note(quiet, loadSummary(renderer, parseSeconds, startToRenderer, ls.scene.triangles.size()));  // load_report.h
   if (!share) writeOutput(renderer, out, tone, denoise, aovs, quiet);
-  {
-    const std::string json = renderStatsJson(renderer, renderer.errorEstimate(), result, budget.targetError > 0.0 && budget.adaptive);
-    note(quiet, "stats " + json);
-    if (!statsFile.empty())
-      writeFileAtomically(statsFile, ".tmp", [&](const std::string& tmp) {
-        std::ofstream f(tmp, std::ios::trunc);
-        f << json << "\n";
-        f.close();
-        if (!f) throw Error(tmp + ": cannot write the statistics");
-      });
-  }
+  writeStats(renderer, result, budget, statsFile, quiet);
   if (!complete) {
-    // Always said, even with --quiet: it explains the exit status.
-    std::string saved;
-    try {
-      saveCheckpoint();
-      saved = (share ? " " : " and checkpoint ") + checkpointFile + " (continue with --resume " + checkpointFile + ")";
-    } catch (const Error& e) {
-      saved = "; no checkpoint: " + std::string(e.what());
-    }
-    if (share)
-      std::fprintf(stderr, "caustica: interrupted at %d/%d samples of %s after %.0f s; wrote the partial%s\n",
-                   renderer.samplesPerPixel(), budget.maxSpp, describeShare(*share).c_str(), total, saved.c_str());
-    else
-      std::fprintf(stderr, "caustica: interrupted at %d/%d spp after %.0f s; wrote %s (partial)%s\n",
-                   renderer.samplesPerPixel(), spp, total, out.c_str(), saved.c_str());
+    reportInterrupted(saveCheckpoint, checkpointFile, share, renderer.samplesPerPixel(), budget.maxSpp, spp, total, out);
     return kExitInterrupted;
   }
   if (share) {

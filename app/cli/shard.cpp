@@ -72,9 +72,12 @@ void addAccumulation(AccumulationState& a, const AccumulationState& b) {
   a.spp += b.spp;
 }
 
-MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) {
-  if (parts.empty()) throw Error("no parts to merge");
-  // Each part on its own: a shard's partial, consistent with its share.
+namespace {
+
+using SampleRanges = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+// Each part on its own: a shard's partial, consistent with its share.
+void checkEachPart(const std::vector<MergePart>& parts) {
   for (const MergePart& p : parts) {
     const Checkpoint& ck = p.checkpoint;
     if (!ck.shard)
@@ -86,7 +89,10 @@ MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) 
       throw Error(p.path + ": " + describeShare(s) + " holds " + std::to_string(ck.state.spp) +
                   " samples ending before sample " + std::to_string(ck.state.sampleBase) + ", outside its share");
   }
-  // The parts together: one render (scene, settings, --spp, size).
+}
+
+// The parts together: one render (scene, settings, --spp, size) as the first part `ref`.
+void checkPartsAgree(const std::vector<MergePart>& parts) {
   const MergePart& ref = parts.front();
   for (const MergePart& p : parts) {
     const Checkpoint& a = ref.checkpoint;
@@ -111,7 +117,10 @@ MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) 
       });
     });
   }
-  // Shares: sorted by their first sample; no two may overlap (the same shard given twice included).
+}
+
+// The parts sorted by their share's first sample; no two shares may overlap (the same shard given twice included).
+std::vector<const MergePart*> sortedDisjointParts(const std::vector<MergePart>& parts) {
   std::vector<const MergePart*> order;
   for (const MergePart& p : parts) order.push_back(&p);
   std::stable_sort(order.begin(), order.end(), [](const MergePart* x, const MergePart* y) {
@@ -128,9 +137,11 @@ MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) 
                   ") overlap" + (same ? ": the same shard given twice" : ": their samples would count twice"));
     }
   }
-  MergeResult result;
-  result.total = ref.checkpoint.shard->total;
-  // Incomplete shards: their unrendered tails are missing.
+  return order;
+}
+
+// The first incomplete shard (its unrendered tail is missing) with how to continue it; empty when none.
+std::string firstIncomplete(const std::vector<const MergePart*>& order) {
   std::string incomplete;
   for (const MergePart* p : order) {
     const Checkpoint& ck = p->checkpoint;
@@ -142,42 +153,50 @@ MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) 
                      std::to_string(ck.shard->count) + " --resume " + p->path + ")";
     }
   }
-  // Every sample index of [0, total) not held by a part.
+  return incomplete;
+}
+
+// Every sample index of [0, total) not held by a part (`order` sorted by first sample).
+SampleRanges missingSamples(const std::vector<const MergePart*>& order, std::uint32_t total) {
+  SampleRanges missing;
   std::uint32_t covered = 0;
   for (const MergePart* p : order) {
     const SampleShare& s = *p->checkpoint.shard;
     if (s.first == s.end) continue;
-    if (s.first > covered) result.missing.emplace_back(covered, s.first);
-    if (p->checkpoint.state.sampleBase < s.end) result.missing.emplace_back(p->checkpoint.state.sampleBase, s.end);
+    if (s.first > covered) missing.emplace_back(covered, s.first);
+    if (p->checkpoint.state.sampleBase < s.end) missing.emplace_back(p->checkpoint.state.sampleBase, s.end);
     covered = std::max(covered, s.end);
   }
-  if (covered < result.total) result.missing.emplace_back(covered, result.total);
-  if (!allowPartial) {
-    if (!incomplete.empty()) throw Error(incomplete + "; or merge what there is with --partial");
-    if (!result.missing.empty()) {
-      // Name the missing shards when every part splits the render into the same N.
-      const int n = ref.checkpoint.shard->count;
-      bool sameN = true;
-      for (const MergePart& p : parts) sameN = sameN && p.checkpoint.shard->count == n;
-      std::string what;
-      for (const auto& [first, end] : result.missing) {
-        std::string shards;
-        if (sameN)
-          for (int k = 1; k <= n; ++k) {
-            const SampleShare s = shareOf(k, n, int(result.total));
-            if (s.first < end && s.end > first) shards += (shards.empty() ? "" : ", ") + std::to_string(k) + "/" + std::to_string(n);
-          }
-        what += (what.empty() ? "" : "; ") + (shards.empty() ? "" : "shard " + shards + " ") + "(samples " + range(first, end) + ")";
+  if (covered < total) missing.emplace_back(covered, total);
+  return missing;
+}
+
+// The missing sample ranges, each with the shards K/N that would render it when every part splits the
+// render into the same N.
+std::string describeMissing(const std::vector<MergePart>& parts, const SampleRanges& missing, std::uint32_t total) {
+  const int n = parts.front().checkpoint.shard->count;
+  bool sameN = true;
+  for (const MergePart& p : parts) sameN = sameN && p.checkpoint.shard->count == n;
+  std::string what;
+  for (const auto& [first, end] : missing) {
+    std::string shards;
+    if (sameN)
+      for (int k = 1; k <= n; ++k) {
+        const SampleShare s = shareOf(k, n, int(total));
+        if (s.first < end && s.end > first) shards += (shards.empty() ? "" : ", ") + std::to_string(k) + "/" + std::to_string(n);
       }
-      throw Error("missing " + what + " of the " + std::to_string(result.total) +
-                  "-spp render: no part given holds them (render them with --shard, or merge what there is with --partial)");
-    }
+    what += (what.empty() ? "" : "; ") + (shards.empty() ? "" : "shard " + shards + " ") + "(samples " + range(first, end) + ")";
   }
-  // Sums in sample order (the order does not matter beyond float rounding).
+  return what;
+}
+
+// The parts' sums added in sample order (the order does not matter beyond float rounding) into `result`,
+// with the seed, scene hash and identity of `ref` (the first part given).
+void addParts(const Checkpoint& ref, const std::vector<const MergePart*>& order, MergeResult& result) {
   Checkpoint& m = result.merged;
-  m.seed = ref.checkpoint.seed;
-  m.sceneHash = ref.checkpoint.sceneHash;
-  m.identity = ref.checkpoint.identity;
+  m.seed = ref.seed;
+  m.sceneHash = ref.sceneHash;
+  m.identity = ref.identity;
   m.state = order.front()->checkpoint.state;
   for (size_t i = 1; i < order.size(); ++i) addAccumulation(m.state, order[i]->checkpoint.state);
   // Resumable only when the samples run from 0 without a gap: then the next sample is their count.
@@ -187,6 +206,27 @@ MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) 
     if (p->checkpoint.shard->first == gapless) gapless = p->checkpoint.state.sampleBase;
   result.resumable = gapless == held;
   m.state.sampleBase = held;
+}
+
+}  // namespace
+
+MergeResult mergeShards(const std::vector<MergePart>& parts, bool allowPartial) {
+  if (parts.empty()) throw Error("no parts to merge");
+  checkEachPart(parts);
+  checkPartsAgree(parts);
+  const std::vector<const MergePart*> order = sortedDisjointParts(parts);
+  MergeResult result;
+  result.total = parts.front().checkpoint.shard->total;
+  const std::string incomplete = firstIncomplete(order);
+  result.missing = missingSamples(order, result.total);
+  if (!allowPartial) {
+    if (!incomplete.empty()) throw Error(incomplete + "; or merge what there is with --partial");
+    if (!result.missing.empty())
+      throw Error("missing " + describeMissing(parts, result.missing, result.total) + " of the " +
+                  std::to_string(result.total) +
+                  "-spp render: no part given holds them (render them with --shard, or merge what there is with --partial)");
+  }
+  addParts(parts.front().checkpoint, order, result);
   return result;
 }
 

@@ -132,27 +132,65 @@ float denoiseTapWeight(const float np[3], const float nq[3], float zp, float zq,
   return denoiseNormalWeight(np, nq) * std::exp(-(std::abs(zp - zq) / depthScaleValue + std::abs(lumDiff) / luminanceScale));
 }
 
-std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& settings) {
-  const std::size_t pixels = static_cast<std::size_t>(in.width) * static_cast<std::size_t>(in.height);
-  if (!in.accum || !in.albedo || !in.normal || in.accum->size() != pixels * 4 || in.albedo->size() != pixels * 4 ||
-      in.normal->size() != pixels * 4)
-    throw Error("internal: the denoiser's inputs do not match the image size");
-  if (settings.iterations < 1) throw Error("internal: the denoiser needs at least one pass");
-  const Sums s(in);
-  const int w = in.width, h = in.height;
-  auto idx = [w](int x, int y) { return static_cast<std::size_t>(y) * w + x; };
-  // prepare: demodulated illumination and the variance of the mean (ping), guide (normal, albedo,
-  // distance), albedo and distance gradient (centre).
-  std::vector<vec4> ping(pixels), guide(pixels), centre(pixels);
+namespace {
+
+// The images the stages hand on, as the shader's: ping and pong (demodulated illumination, variance of
+// its mean; a pass reads ping, writes pong, then they swap), guide (normal, albedo, distance), centre
+// (albedo, distance gradient), residual and spread (what the filter took: rgb, the filtered
+// illumination's luminance), and the output (sums: rgb x n, n a pixel).
+struct DenoiseImages {
+  std::vector<vec4> ping, pong, guide, centre, residual, spread;
+  std::vector<float> out;
+};
+
+std::size_t pixelIndex(int w, int x, int y) { return static_cast<std::size_t>(y) * w + x; }
+
+// Output pixel i as sums: value x n, and n.
+void writeOut(std::vector<float>& out, std::size_t i, vec3 value, float n) {
+  const vec3 c = value * n;
+  out[i * 4 + 0] = c.x;
+  out[i * 4 + 1] = c.y;
+  out[i * 4 + 2] = c.z;
+  out[i * 4 + 3] = n;
+}
+
+// The variance of pixel (x, y)'s luminance from the luminance moments of the similar pixels around it
+// (5x5), for pixels with too few samples for their own.
+float neighbourhoodVariance(const Sums& s, const DenoiseSettings& settings, int x, int y, const vec4& nz, float gradient) {
+  const float z = nz.w;
+  float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+  const float np[3] = {nz.x, nz.y, nz.z};
+  for (int j = -2; j <= 2; ++j)
+    for (int k = -2; k <= 2; ++k) {
+      const int qx = x + k, qy = y + j;
+      if (!s.inside(qx, qy)) continue;
+      const vec4 gq = s.normalDistance(qx, qy);
+      if (gq.w < 0.0f) continue;
+      const float nq[3] = {gq.x, gq.y, gq.z};
+      const vec4 aq = s.accum(qx, qy);
+      const float l = luminance(vec3(aq) / aq.w);
+      const float wq = denoiseTapWeight(np, nq, z, gq.w,
+                                        denoiseDepthScale(settings.sigmaDepth, gradient, std::max(std::abs(j), std::abs(k)), z), 0.0f, 1.0f);
+      s0 += wq;
+      s1 += wq * l;
+      s2 += wq * l * l;
+    }
+  const float m = s1 / s0;
+  return std::max(s2 / s0 - m * m, 0.0f);
+}
+
+// prepare (CAUSTICA_DENOISE_PREPARE): demodulated illumination and the variance of the mean (ping), guide
+// (normal, albedo, distance), albedo and distance gradient (centre).
+void denoisePrepare(const Sums& s, const DenoiseSettings& settings, int w, int h, DenoiseImages& im) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const vec4 acc = s.accum(x, y);
-      const std::size_t i = idx(x, y);
+      const std::size_t i = pixelIndex(w, x, y);
       const vec4 nz = s.normalDistance(x, y);
       if (!(acc.w > 0.0f)) {
-        guide[i] = nz;
-        ping[i] = vec4(0.0f);
-        centre[i] = vec4(1.0f, 1.0f, 1.0f, 0.0f);
+        im.guide[i] = nz;
+        im.ping[i] = vec4(0.0f);
+        im.centre[i] = vec4(1.0f, 1.0f, 1.0f, 0.0f);
         continue;
       }
       const float n = acc.w;
@@ -162,123 +200,117 @@ std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& se
       const vec3 illum = mean / alb;
       const float z = nz.w;
       const float gradient = denoiseAxisGradient(s, x, y, 1, 0, z) + denoiseAxisGradient(s, x, y, 0, 1, z);
-      float var;
-      if (n >= kDenoiseMinTemporalSamples) {
-        var = denoiseMeanVariance(n, as.w, luminance(mean));
-      } else {  // luminance moments of the similar pixels around
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        const float np[3] = {nz.x, nz.y, nz.z};
-        for (int j = -2; j <= 2; ++j)
-          for (int k = -2; k <= 2; ++k) {
-            const int qx = x + k, qy = y + j;
-            if (!s.inside(qx, qy)) continue;
-            const vec4 gq = s.normalDistance(qx, qy);
-            if (gq.w < 0.0f) continue;
-            const float nq[3] = {gq.x, gq.y, gq.z};
-            const vec4 aq = s.accum(qx, qy);
-            const float l = luminance(vec3(aq) / aq.w);
-            const float wq = denoiseTapWeight(np, nq, z, gq.w,
-                                              denoiseDepthScale(settings.sigmaDepth, gradient, std::max(std::abs(j), std::abs(k)), z), 0.0f, 1.0f);
-            s0 += wq;
-            s1 += wq * l;
-            s2 += wq * l * l;
-          }
-        const float m = s1 / s0;
-        var = std::max(s2 / s0 - m * m, 0.0f);
-      }
-      guide[i] = denoiseGuide(vec3(nz), luminance(alb), z);
-      ping[i] = vec4(illum, var);
-      centre[i] = vec4(alb, gradient);
+      const float var = n >= kDenoiseMinTemporalSamples ? denoiseMeanVariance(n, as.w, luminance(mean))
+                                                        : neighbourhoodVariance(s, settings, x, y, nz, gradient);
+      im.guide[i] = denoiseGuide(vec3(nz), luminance(alb), z);
+      im.ping[i] = vec4(illum, var);
+      im.centre[i] = vec4(alb, gradient);
     }
-  // The à-trous passes: 3x3 taps `step` pixels apart, weighted by the kernel and denoiseTapWeight.
-  std::vector<vec4> pong(pixels);
-  std::vector<vec4> residual(settings.residualPasses > 0 ? pixels : 0);  // rgb, and the filtered luminance
-  std::vector<float> out(pixels * 4, 0.0f);
-  auto writeOut = [&](std::size_t i, vec3 value, float n) {
-    const vec3 c = value * n;
-    out[i * 4 + 0] = c.x;
-    out[i * 4 + 1] = c.y;
-    out[i * 4 + 2] = c.z;
-    out[i * 4 + 3] = n;
-  };
-  for (int pass = 0; pass < settings.iterations; ++pass) {
-    const int step = 1 << pass;
-    const bool last = pass + 1 == settings.iterations;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = idx(x, y);
-        const vec4 gp = guide[i];
-        if (gp.w < 0.0f) {
-          pong[i] = vec4(0.0f);
-          if (last && !residual.empty()) residual[i] = vec4(0.0f);
-          continue;
-        }
-        const vec4 cp = ping[i], ctr = centre[i];
-        const vec3 npv = denoiseGuideNormal(gp);
-        const float np[3] = {npv.x, npv.y, npv.z};
-        const float ap = denoiseGuideAlbedo(gp);
-        const float ds = denoiseDepthScale(settings.sigmaDepth, ctr.w, step, gp.w);
-        float sumW = kKernel[0] * kKernel[0];
-        vec3 sumI = sumW * vec3(cp);
-        float sumV = sumW * sumW * cp.w;
-        forEachTap(s, guide, w, x, y, step, [&](std::size_t q, float kernel, const vec4& gq, const float nq[3]) {
-          const vec4 cq = ping[q];
-          const float lumDiff = luminance(vec3(ctr) * (vec3(cq) - vec3(cp)));
-          const float ls = denoiseLuminanceScale(settings.sigmaLuminance, cp.w, cq.w, ap, denoiseGuideAlbedo(gq));
-          const float wq = kernel * denoiseTapWeight(np, nq, gp.w, gq.w, ds, lumDiff, ls);
-          sumW += wq;
-          sumI += wq * vec3(cq);
-          sumV += wq * wq * cq.w;
-        });
-        const vec3 illum = sumI / sumW;
-        pong[i] = vec4(illum, sumV / (sumW * sumW));
-        if (!last) continue;
+}
+
+// One à-trous pass (CAUSTICA_DENOISE_PASS): 3x3 taps `step` pixels apart, weighted by the kernel and
+// denoiseTapWeight, ping into pong. The last one writes the output, or, with residual passes to come,
+// what the filter took from each pixel with the filtered luminance.
+void denoisePass(const Sums& s, const DenoiseSettings& settings, int w, int h, int pass, DenoiseImages& im) {
+  const int step = 1 << pass;
+  const bool last = pass + 1 == settings.iterations;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = pixelIndex(w, x, y);
+      const vec4 gp = im.guide[i];
+      if (gp.w < 0.0f) {
+        im.pong[i] = vec4(0.0f);
+        if (last && !im.residual.empty()) im.residual[i] = vec4(0.0f);
+        continue;
+      }
+      const vec4 cp = im.ping[i], ctr = im.centre[i];
+      const vec3 npv = denoiseGuideNormal(gp);
+      const float np[3] = {npv.x, npv.y, npv.z};
+      const float ap = denoiseGuideAlbedo(gp);
+      const float ds = denoiseDepthScale(settings.sigmaDepth, ctr.w, step, gp.w);
+      float sumW = kKernel[0] * kKernel[0];
+      vec3 sumI = sumW * vec3(cp);
+      float sumV = sumW * sumW * cp.w;
+      forEachTap(s, im.guide, w, x, y, step, [&](std::size_t q, float kernel, const vec4& gq, const float nq[3]) {
+        const vec4 cq = im.ping[q];
+        const float lumDiff = luminance(vec3(ctr) * (vec3(cq) - vec3(cp)));
+        const float ls = denoiseLuminanceScale(settings.sigmaLuminance, cp.w, cq.w, ap, denoiseGuideAlbedo(gq));
+        const float wq = kernel * denoiseTapWeight(np, nq, gp.w, gq.w, ds, lumDiff, ls);
+        sumW += wq;
+        sumI += wq * vec3(cq);
+        sumV += wq * wq * cq.w;
+      });
+      const vec3 illum = sumI / sumW;
+      im.pong[i] = vec4(illum, sumV / (sumW * sumW));
+      if (!last) continue;
+      const vec4 acc = s.accum(x, y);
+      if (im.residual.empty()) writeOut(im.out, i, vec3(ctr) * illum, acc.w);
+      else im.residual[i] = vec4(vec3(acc) / acc.w - vec3(ctr) * illum, luminance(illum));  // what the filter took away
+    }
+  std::swap(im.ping, im.pong);
+}
+
+// One residual pass (CAUSTICA_DENOISE_RESIDUAL): the same taps, weighted by normal, distance and the
+// relative difference of the filtered illumination's luminance, spread what the filter took from each
+// pixel over its surface and its like, so the image keeps its energy (a firefly's, a caustic's) where it
+// was; the last one writes the output: the filtered image plus that.
+void denoiseResidualPass(const Sums& s, const DenoiseSettings& settings, int w, int h, int pass, DenoiseImages& im) {
+  const int step = 1 << pass;
+  const bool last = pass + 1 == settings.residualPasses;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = pixelIndex(w, x, y);
+      const vec4 gp = im.guide[i];
+      if (gp.w < 0.0f) {
+        im.spread[i] = vec4(0.0f);
+        continue;
+      }
+      const vec4 rp = im.residual[i];
+      const vec3 npv = denoiseGuideNormal(gp);
+      const float np[3] = {npv.x, npv.y, npv.z};
+      const float ds = denoiseDepthScale(settings.sigmaDepth, im.centre[i].w, step, gp.w);
+      float sumW = kKernel[0] * kKernel[0];
+      vec3 sumR = sumW * vec3(rp);
+      forEachTap(s, im.guide, w, x, y, step, [&](std::size_t q, float kernel, const vec4& gq, const float nq[3]) {
+        const vec4 rq = im.residual[q];
+        const float wq = kernel * denoiseTapWeight(np, nq, gp.w, gq.w, ds, rp.w - rq.w, settings.sigmaResidual * (rp.w + rq.w) + kTiny);
+        sumW += wq;
+        sumR += wq * vec3(rq);
+      });
+      im.spread[i] = vec4(sumR / sumW, rp.w);
+      if (last) {
         const vec4 acc = s.accum(x, y);
-        if (residual.empty()) writeOut(i, vec3(ctr) * illum, acc.w);
-        else residual[i] = vec4(vec3(acc) / acc.w - vec3(ctr) * illum, luminance(illum));  // what the filter took away
+        vec3 correction = vec3(im.spread[i]);
+        if (acc.w >= kDenoiseMinTemporalSamples)
+          correction = denoiseBoundedCorrection(correction, settings.residualBound, acc.w, s.albedo(x, y).w, luminance(vec3(acc) / acc.w));
+        writeOut(im.out, i, vec3(im.centre[i]) * vec3(im.ping[i]) + correction, acc.w);
       }
-    std::swap(ping, pong);
-  }
-  // The residual passes: the same taps, weighted by normal, distance and the relative difference of the
-  // filtered illumination's luminance, spread what the filter took from each pixel over its surface and
-  // its like, so the image keeps its energy (a firefly's, a caustic's) where it was; the output is the
-  // filtered image plus that.
-  std::vector<vec4> spread(residual.size());
-  for (int pass = 0; pass < settings.residualPasses; ++pass) {
-    const int step = 1 << pass;
-    const bool last = pass + 1 == settings.residualPasses;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = idx(x, y);
-        const vec4 gp = guide[i];
-        if (gp.w < 0.0f) {
-          spread[i] = vec4(0.0f);
-          continue;
-        }
-        const vec4 rp = residual[i];
-        const vec3 npv = denoiseGuideNormal(gp);
-        const float np[3] = {npv.x, npv.y, npv.z};
-        const float ds = denoiseDepthScale(settings.sigmaDepth, centre[i].w, step, gp.w);
-        float sumW = kKernel[0] * kKernel[0];
-        vec3 sumR = sumW * vec3(rp);
-        forEachTap(s, guide, w, x, y, step, [&](std::size_t q, float kernel, const vec4& gq, const float nq[3]) {
-          const vec4 rq = residual[q];
-          const float wq = kernel * denoiseTapWeight(np, nq, gp.w, gq.w, ds, rp.w - rq.w, settings.sigmaResidual * (rp.w + rq.w) + kTiny);
-          sumW += wq;
-          sumR += wq * vec3(rq);
-        });
-        spread[i] = vec4(sumR / sumW, rp.w);
-        if (last) {
-          const vec4 acc = s.accum(x, y);
-          vec3 correction = vec3(spread[i]);
-          if (acc.w >= kDenoiseMinTemporalSamples)
-            correction = denoiseBoundedCorrection(correction, settings.residualBound, acc.w, s.albedo(x, y).w, luminance(vec3(acc) / acc.w));
-          writeOut(i, vec3(centre[i]) * vec3(ping[i]) + correction, acc.w);
-        }
-      }
-    std::swap(residual, spread);
-  }
-  return out;
+    }
+  std::swap(im.residual, im.spread);
+}
+
+}  // namespace
+
+std::vector<float> denoiseSums(const DenoiseInput& in, const DenoiseSettings& settings) {
+  const std::size_t pixels = static_cast<std::size_t>(in.width) * static_cast<std::size_t>(in.height);
+  if (!in.accum || !in.albedo || !in.normal || in.accum->size() != pixels * 4 || in.albedo->size() != pixels * 4 ||
+      in.normal->size() != pixels * 4)
+    throw Error("internal: the denoiser's inputs do not match the image size");
+  if (settings.iterations < 1) throw Error("internal: the denoiser needs at least one pass");
+  const Sums s(in);
+  const int w = in.width, h = in.height;
+  DenoiseImages im;
+  im.ping.resize(pixels);
+  im.guide.resize(pixels);
+  im.centre.resize(pixels);
+  denoisePrepare(s, settings, w, h, im);
+  im.pong.resize(pixels);
+  im.residual.resize(settings.residualPasses > 0 ? pixels : 0);
+  im.out.assign(pixels * 4, 0.0f);
+  for (int pass = 0; pass < settings.iterations; ++pass) denoisePass(s, settings, w, h, pass, im);
+  im.spread.resize(im.residual.size());
+  for (int pass = 0; pass < settings.residualPasses; ++pass) denoiseResidualPass(s, settings, w, h, pass, im);
+  return im.out;
 }
 
 FeatureImages featureImages(const DenoiseInput& in) {

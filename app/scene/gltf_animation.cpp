@@ -57,9 +57,57 @@ void SceneBuilder::readAnimations() {
       fail("--animation " + oneLine(pose_.animation) + ": the file has no animations");
     return;
   }
-  // Which animations play. By default: every one when no two animate the same property of a node
-  // (exporters such as COLLADA2GLTF write one animation per node of one motion), else the first (the
-  // file holds alternative motions: Walk, Run, ...). "all": every one; else one by name or index.
+  const std::vector<bool> played = chooseAnimations();
+  scene_.animationTime = pose_.time;
+  std::map<int, std::vector<double>> times;  // input accessor -> key times (samplers often share them)
+  std::set<int> warnedMatrix;
+  for (std::size_t a = 0; a < count; ++a) {
+    const tinygltf::Animation& anim = model_.animations[a];
+    const std::string aat = "animations[" + str(a) + "]";
+    AnimationInfo info;
+    info.name = oneLine(anim.name);
+    info.start = std::numeric_limits<double>::infinity();
+    info.end = -std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < anim.channels.size(); ++c) {
+      const tinygltf::AnimationChannel& ch = anim.channels[c];
+      const std::string cat = aat + ".channels[" + str(c) + "]";
+      if (ch.sampler < 0 || std::size_t(ch.sampler) >= anim.samplers.size())
+        fail(cat + ".sampler is " + std::to_string(ch.sampler) + ", but " + aat + " has " + str(anim.samplers.size()) +
+             " samplers");
+      if (ch.target_node < 0) continue;  // no target (e.g. KHR_animation_pointer): nothing this file moves
+      if (std::size_t(ch.target_node) >= model_.nodes.size())
+        fail(cat + ".target.node is " + std::to_string(ch.target_node) + ", but the file has " + str(model_.nodes.size()) +
+             " nodes");
+      const bool isWeights = ch.target_path == "weights";
+      if (ch.target_path != "translation" && ch.target_path != "rotation" && ch.target_path != "scale" && !isWeights) {
+        warn(cat + ".target.path '" + oneLine(ch.target_path) + "' is not supported; the channel is ignored");
+        continue;
+      }
+      const tinygltf::AnimationSampler& sm = anim.samplers[std::size_t(ch.sampler)];
+      const std::string sat = aat + ".samplers[" + str(std::uint64_t(ch.sampler)) + "]";
+      KeyframeCurve curve = curveKeys(sm, sat, times);
+      info.start = std::min(info.start, curve.times.front());
+      info.end = std::max(info.end, curve.times.back());
+      ++info.channels;
+      if (isWeights) info.weights = true;
+      for (const tinygltf::Skin& skin : model_.skins)
+        if (std::find(skin.joints.begin(), skin.joints.end(), ch.target_node) != skin.joints.end()) info.skins = true;
+      if (!played[a]) continue;
+      // The played animation: outputs read, checked against the key count, sampled at the pose's time.
+      if (!readCurveValues(ch, sm, cat, sat, curve)) continue;
+      applyAnimatedValue(ch, sat, sampleCurve(curve, pose_.time), warnedMatrix);
+    }
+    if (info.channels == 0) info.start = info.end = 0.0;
+    scene_.animations.push_back(info);
+    if (played[a]) scene_.animationsPlayed.push_back(int(a));
+  }
+}
+
+// Which animations play. By default: every one when no two animate the same property of a node
+// (exporters such as COLLADA2GLTF write one animation per node of one motion), else the first (the
+// file holds alternative motions: Walk, Run, ...). "all": every one; else one by name or index.
+std::vector<bool> SceneBuilder::chooseAnimations() {
+  const std::size_t count = model_.animations.size();
   std::vector<bool> played(count, false);
   if (pose_.animation.empty()) {
     std::set<std::pair<int, std::string>> targets;
@@ -90,109 +138,91 @@ void SceneBuilder::readAnimations() {
     }
     played[std::size_t(found)] = true;
   }
-  scene_.animationTime = pose_.time;
-  std::map<int, std::vector<double>> times;  // input accessor -> key times (samplers often share them)
-  std::set<int> warnedMatrix;
-  for (std::size_t a = 0; a < count; ++a) {
-    const tinygltf::Animation& anim = model_.animations[a];
-    const std::string aat = "animations[" + str(a) + "]";
-    AnimationInfo info;
-    info.name = oneLine(anim.name);
-    info.start = std::numeric_limits<double>::infinity();
-    info.end = -std::numeric_limits<double>::infinity();
-    for (std::size_t c = 0; c < anim.channels.size(); ++c) {
-      const tinygltf::AnimationChannel& ch = anim.channels[c];
-      const std::string cat = aat + ".channels[" + str(c) + "]";
-      if (ch.sampler < 0 || std::size_t(ch.sampler) >= anim.samplers.size())
-        fail(cat + ".sampler is " + std::to_string(ch.sampler) + ", but " + aat + " has " + str(anim.samplers.size()) +
-             " samplers");
-      if (ch.target_node < 0) continue;  // no target (e.g. KHR_animation_pointer): nothing this file moves
-      if (std::size_t(ch.target_node) >= model_.nodes.size())
-        fail(cat + ".target.node is " + std::to_string(ch.target_node) + ", but the file has " + str(model_.nodes.size()) +
-             " nodes");
-      const bool isWeights = ch.target_path == "weights";
-      if (ch.target_path != "translation" && ch.target_path != "rotation" && ch.target_path != "scale" && !isWeights) {
-        warn(cat + ".target.path '" + oneLine(ch.target_path) + "' is not supported; the channel is ignored");
-        continue;
-      }
-      const tinygltf::AnimationSampler& sm = anim.samplers[std::size_t(ch.sampler)];
-      const std::string sat = aat + ".samplers[" + str(std::uint64_t(ch.sampler)) + "]";
-      KeyframeCurve curve;
-      if (sm.interpolation == "LINEAR" || sm.interpolation.empty()) curve.interpolation = Interpolation::Linear;
-      else if (sm.interpolation == "STEP") curve.interpolation = Interpolation::Step;
-      else if (sm.interpolation == "CUBICSPLINE") curve.interpolation = Interpolation::CubicSpline;
-      else fail(sat + ".interpolation '" + oneLine(sm.interpolation) + "' is not LINEAR, STEP or CUBICSPLINE");
-      auto cached = times.find(sm.input);
-      if (cached == times.end()) {
-        std::vector<double> t = readAccessor(sm.input, TINYGLTF_TYPE_SCALAR, kFloat, sat + ".input");
-        if (t.empty()) fail(sat + ".input has no key times");
-        for (std::size_t k = 0; k < t.size(); ++k) {
-          if (!std::isfinite(t[k])) fail(sat + ".input: key time " + str(k) + " is not finite");
-          if (k > 0 && !(t[k] > t[k - 1]))
-            fail(sat + ".input: key times must increase (key " + str(k) + " is " + num(t[k]) + ", after " + num(t[k - 1]) + ")");
-        }
-        cached = times.emplace(sm.input, std::move(t)).first;
-      }
-      curve.times = cached->second;
-      info.start = std::min(info.start, curve.times.front());
-      info.end = std::max(info.end, curve.times.back());
-      ++info.channels;
-      const tinygltf::Node& node = model_.nodes[std::size_t(ch.target_node)];
-      if (isWeights) info.weights = true;
-      for (const tinygltf::Skin& skin : model_.skins)
-        if (std::find(skin.joints.begin(), skin.joints.end(), ch.target_node) != skin.joints.end()) info.skins = true;
-      if (!played[a]) continue;
-      // The played animation: outputs read, checked against the key count, sampled at the pose's time.
-      const std::string nat = "nodes[" + str(std::uint64_t(ch.target_node)) + "]";
-      if (isWeights) {
-        curve.components = targetCount(model_, node.mesh);
-        if (curve.components == 0) {
-          warn(cat + " animates the morph weights of " + nat + ", which has no mesh with morph targets; ignored");
-          continue;
-        }
-        curve.values = readAccessor(sm.output, TINYGLTF_TYPE_SCALAR, kFloatOrNormalized, sat + ".output");
-      } else if (ch.target_path == "rotation") {
-        curve.components = 4;
-        curve.rotation = true;
-        curve.values = readAccessor(sm.output, TINYGLTF_TYPE_VEC4, kFloatOrNormalized, sat + ".output");
-      } else {
-        curve.components = 3;
-        curve.values = readAccessor(sm.output, TINYGLTF_TYPE_VEC3, kFloat, sat + ".output");
-      }
-      const std::size_t perKey = curve.components * (curve.interpolation == Interpolation::CubicSpline ? 3 : 1);
-      if (curve.values.size() != curve.times.size() * perKey)
-        fail(sat + ".output has " + str(curve.values.size() / (isWeights ? 1 : curve.components)) + " elements; " +
-             str(curve.times.size()) + " keys of " + interpolationName(curve.interpolation) + " need " +
-             str(curve.times.size() * perKey / (isWeights ? 1 : curve.components)) +
-             (isWeights ? " (" + str(curve.components) + " morph weights a key)" : ""));
-      for (std::size_t i = 0; i < curve.values.size(); ++i)
-        if (!std::isfinite(curve.values[i])) fail(sat + ".output: value " + str(i) + " is not finite");
-      const std::vector<double> v = sampleCurve(curve, pose_.time);
-      if (isWeights) {
-        animatedWeights_[ch.target_node] = v;
-        continue;
-      }
-      if (node.matrix.size() == 16) {
-        if (warnedMatrix.insert(ch.target_node).second)
-          warn(nat + " has a matrix and is animated (glTF allows only TRS on animated nodes); the animation of it is ignored");
-        continue;
-      }
-      auto it = animatedTrs_.find(ch.target_node);
-      if (it == animatedTrs_.end()) it = animatedTrs_.emplace(ch.target_node, staticTrs(node)).first;
-      if (ch.target_path == "translation") {
-        it->second.translation = glm::dvec3(v[0], v[1], v[2]);
-      } else if (ch.target_path == "scale") {
-        it->second.scale = glm::dvec3(v[0], v[1], v[2]);
-      } else {
-        const glm::dquat q(v[3], v[0], v[1], v[2]);
-        const double length = glm::length(q);
-        if (!(length > 1e-12)) fail(sat + ": the rotation at t = " + num(pose_.time) + " s is not a unit quaternion");
-        it->second.rotation = q / length;
-      }
+  return played;
+}
+
+// A sampler's interpolation and key times (read and checked once per input accessor: `times` caches them).
+KeyframeCurve SceneBuilder::curveKeys(const tinygltf::AnimationSampler& sm, const std::string& sat,
+                                      std::map<int, std::vector<double>>& times) {
+  KeyframeCurve curve;
+  if (sm.interpolation == "LINEAR" || sm.interpolation.empty()) curve.interpolation = Interpolation::Linear;
+  else if (sm.interpolation == "STEP") curve.interpolation = Interpolation::Step;
+  else if (sm.interpolation == "CUBICSPLINE") curve.interpolation = Interpolation::CubicSpline;
+  else fail(sat + ".interpolation '" + oneLine(sm.interpolation) + "' is not LINEAR, STEP or CUBICSPLINE");
+  auto cached = times.find(sm.input);
+  if (cached == times.end()) {
+    std::vector<double> t = readAccessor(sm.input, TINYGLTF_TYPE_SCALAR, kFloat, sat + ".input");
+    if (t.empty()) fail(sat + ".input has no key times");
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      if (!std::isfinite(t[k])) fail(sat + ".input: key time " + str(k) + " is not finite");
+      if (k > 0 && !(t[k] > t[k - 1]))
+        fail(sat + ".input: key times must increase (key " + str(k) + " is " + num(t[k]) + ", after " + num(t[k - 1]) + ")");
     }
-    if (info.channels == 0) info.start = info.end = 0.0;
-    scene_.animations.push_back(info);
-    if (played[a]) scene_.animationsPlayed.push_back(int(a));
+    cached = times.emplace(sm.input, std::move(t)).first;
+  }
+  curve.times = cached->second;
+  return curve;
+}
+
+// The channel's output values, checked against the key count; false when the channel is ignored
+// (weights of a node without morph targets: warned).
+bool SceneBuilder::readCurveValues(const tinygltf::AnimationChannel& ch, const tinygltf::AnimationSampler& sm,
+                                   const std::string& cat, const std::string& sat, KeyframeCurve& curve) {
+  const tinygltf::Node& node = model_.nodes[std::size_t(ch.target_node)];
+  const bool isWeights = ch.target_path == "weights";
+  const std::string nat = "nodes[" + str(std::uint64_t(ch.target_node)) + "]";
+  if (isWeights) {
+    curve.components = targetCount(model_, node.mesh);
+    if (curve.components == 0) {
+      warn(cat + " animates the morph weights of " + nat + ", which has no mesh with morph targets; ignored");
+      return false;
+    }
+    curve.values = readAccessor(sm.output, TINYGLTF_TYPE_SCALAR, kFloatOrNormalized, sat + ".output");
+  } else if (ch.target_path == "rotation") {
+    curve.components = 4;
+    curve.rotation = true;
+    curve.values = readAccessor(sm.output, TINYGLTF_TYPE_VEC4, kFloatOrNormalized, sat + ".output");
+  } else {
+    curve.components = 3;
+    curve.values = readAccessor(sm.output, TINYGLTF_TYPE_VEC3, kFloat, sat + ".output");
+  }
+  const std::size_t perKey = curve.components * (curve.interpolation == Interpolation::CubicSpline ? 3 : 1);
+  if (curve.values.size() != curve.times.size() * perKey)
+    fail(sat + ".output has " + str(curve.values.size() / (isWeights ? 1 : curve.components)) + " elements; " +
+         str(curve.times.size()) + " keys of " + interpolationName(curve.interpolation) + " need " +
+         str(curve.times.size() * perKey / (isWeights ? 1 : curve.components)) +
+         (isWeights ? " (" + str(curve.components) + " morph weights a key)" : ""));
+  for (std::size_t i = 0; i < curve.values.size(); ++i)
+    if (!std::isfinite(curve.values[i])) fail(sat + ".output: value " + str(i) + " is not finite");
+  return true;
+}
+
+// The channel's value at the pose's time `v` into animatedWeights_ or the node's TRS in animatedTrs_
+// (a node with a matrix keeps it: warned once a node).
+void SceneBuilder::applyAnimatedValue(const tinygltf::AnimationChannel& ch, const std::string& sat,
+                                      const std::vector<double>& v, std::set<int>& warnedMatrix) {
+  const tinygltf::Node& node = model_.nodes[std::size_t(ch.target_node)];
+  const std::string nat = "nodes[" + str(std::uint64_t(ch.target_node)) + "]";
+  if (ch.target_path == "weights") {
+    animatedWeights_[ch.target_node] = v;
+    return;
+  }
+  if (node.matrix.size() == 16) {
+    if (warnedMatrix.insert(ch.target_node).second)
+      warn(nat + " has a matrix and is animated (glTF allows only TRS on animated nodes); the animation of it is ignored");
+    return;
+  }
+  auto it = animatedTrs_.find(ch.target_node);
+  if (it == animatedTrs_.end()) it = animatedTrs_.emplace(ch.target_node, staticTrs(node)).first;
+  if (ch.target_path == "translation") {
+    it->second.translation = glm::dvec3(v[0], v[1], v[2]);
+  } else if (ch.target_path == "scale") {
+    it->second.scale = glm::dvec3(v[0], v[1], v[2]);
+  } else {
+    const glm::dquat q(v[3], v[0], v[1], v[2]);
+    const double length = glm::length(q);
+    if (!(length > 1e-12)) fail(sat + ": the rotation at t = " + num(pose_.time) + " s is not a unit quaternion");
+    it->second.rotation = q / length;
   }
 }
 

@@ -209,6 +209,14 @@ class SceneBuilder {
   // Reads every animation (for Scene::animations) and samples the chosen one(s) at pose_.time into
   // animatedTrs_ and animatedWeights_; names the chosen ones in Scene::animationsPlayed.
   void readAnimations();
+  // readAnimations' steps, in order (gltf_animation.cpp).
+  std::vector<bool> chooseAnimations();
+  KeyframeCurve curveKeys(const tinygltf::AnimationSampler& sm, const std::string& sat,
+                          std::map<int, std::vector<double>>& times);
+  bool readCurveValues(const tinygltf::AnimationChannel& ch, const tinygltf::AnimationSampler& sm, const std::string& cat,
+                       const std::string& sat, KeyframeCurve& curve);
+  void applyAnimatedValue(const tinygltf::AnimationChannel& ch, const std::string& sat, const std::vector<double>& v,
+                          std::set<int>& warnedMatrix);
   // The node's morph-target weights at the pose (animated, else node.weights, else mesh.weights).
   std::vector<double> nodeWeights(int nodeIndex, int mesh, const std::string& at);
   // World matrices of every node (needed by skins, whose joints may lie anywhere in the tree).
@@ -287,6 +295,19 @@ class SceneBuilder {
   void placeMesh(int mesh, const glm::dmat4& world, const std::string& at, const MeshPose& pose = {});
   void addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at,
                     const MeshPose& pose = {});
+  // addPrimitive's steps, in order (gltf_nodes.cpp).
+  struct PrimitiveVertices;
+  bool acceptPrimitive(const tinygltf::Primitive& prim, const std::string& at);
+  void readVertices(const tinygltf::Primitive& prim, const NodeTransform& xf, const MeshPose& pose,
+                    const std::string& at, PrimitiveVertices& v);
+  std::vector<std::uint32_t> readIndices(const tinygltf::Primitive& prim, DracoPrimitive* draco, std::size_t vertexCount,
+                                         const std::string& at);
+  std::uint32_t primitiveMaterial(const tinygltf::Primitive& prim, const std::string& at);
+  void readSurfaceAttributes(const tinygltf::Primitive& prim, std::uint32_t material, const MeshPose& pose,
+                             const std::string& at, PrimitiveVertices& v);
+  std::size_t countTriangles(const tinygltf::Primitive& prim, std::size_t indexCount, const std::string& at);
+  void addTriangles(const tinygltf::Primitive& prim, const std::vector<std::uint32_t>& indices, std::size_t triangles,
+                    const PrimitiveVertices& v, std::uint32_t material, const NodeTransform& xf, const std::string& at);
 
   const std::string& path_;
   const tinygltf::Model& model_;

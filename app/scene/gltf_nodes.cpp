@@ -430,22 +430,23 @@ void SceneBuilder::addMesh(int meshIndex, const NodeTransform& xf, const std::st
                  pose);
 }
 
+// A primitive's vertex data as addPrimitive's steps read it: 3 doubles a vertex for positions and normals
+// (model space, or world space once skinned), 2 for uvs, colorComponents for colors, 4 for tangents.
+struct SceneBuilder::PrimitiveVertices {
+  std::size_t count = 0;
+  std::vector<double> positions;
+  std::vector<double> normals;
+  std::vector<bool> mirrored;              // mirrored[v]: vertex v's skin matrix mirrors
+  std::vector<std::uint32_t> normalWords;  // world-space octahedral normal a vertex; kOctNoNormal: none
+  std::vector<double> uvs;
+  std::vector<double> colors;
+  int colorComponents = 0;
+  std::vector<double> tangents;
+};
+
 void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTransform& xf, const std::string& at,
                                 const MeshPose& pose) {
-  static const char* const kModeNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
-  if (prim.mode >= 0 && prim.mode <= 3) {
-    skip(at + ": mode " + kModeNames[prim.mode] + " is not supported (triangles only); primitive skipped");
-    return;
-  }
-  if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-      prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-    skip(at + ": mode " + std::to_string(prim.mode) + " is not a valid primitive mode; primitive skipped");
-    return;
-  }
-  if (prim.attributes.find("POSITION") == prim.attributes.end()) {
-    skip(at + " has no POSITION attribute; primitive skipped");
-    return;
-  }
+  if (!acceptPrimitive(prim, at)) return;
   // KHR_draco_mesh_compression: the attributes it lists and the indices come from the Draco data;
   // readAttribute takes them from there while draco_ is set.
   DracoPrimitive draco;
@@ -460,40 +461,80 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     const DracoPrimitive*& p;
     ~ResetDraco() { p = nullptr; }
   } resetDraco{draco_};
-  std::vector<double> positions = readAttribute(prim, "POSITION", TINYGLTF_TYPE_VEC3,
-                                                attributeFormats(VertexAttribute::Position, quantized_), kAnyCount, at);
+  PrimitiveVertices v;
+  readVertices(prim, xf, pose, at, v);
+  const std::vector<std::uint32_t> indices = readIndices(prim, compressed ? &draco : nullptr, v.count, at);
+  const std::uint32_t material = primitiveMaterial(prim, at);
+  readSurfaceAttributes(prim, material, pose, at, v);
+  const std::size_t triangles = countTriangles(prim, indices.size(), at);
+  addTriangles(prim, indices, triangles, v, material, xf, at);
+}
+
+// Whether the primitive can be added: triangles (list, strip or fan) with a POSITION; else it is
+// skipped, and said so.
+bool SceneBuilder::acceptPrimitive(const tinygltf::Primitive& prim, const std::string& at) {
+  static const char* const kModeNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+  if (prim.mode >= 0 && prim.mode <= 3) {
+    skip(at + ": mode " + kModeNames[prim.mode] + " is not supported (triangles only); primitive skipped");
+    return false;
+  }
+  if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    skip(at + ": mode " + std::to_string(prim.mode) + " is not a valid primitive mode; primitive skipped");
+    return false;
+  }
+  if (prim.attributes.find("POSITION") == prim.attributes.end()) {
+    skip(at + " has no POSITION attribute; primitive skipped");
+    return false;
+  }
+  return true;
+}
+
+// POSITION and NORMAL, posed, and each vertex's world-space normal word.
+void SceneBuilder::readVertices(const tinygltf::Primitive& prim, const NodeTransform& xf, const MeshPose& pose,
+                                const std::string& at, PrimitiveVertices& v) {
+  std::vector<double>& positions = v.positions;
+  std::vector<double>& normals = v.normals;
+  positions = readAttribute(prim, "POSITION", TINYGLTF_TYPE_VEC3, attributeFormats(VertexAttribute::Position, quantized_),
+                            kAnyCount, at);
   const std::size_t vertexCount = positions.size() / 3;
+  v.count = vertexCount;
   for (std::size_t i = 0; i < positions.size(); ++i)
     if (!std::isfinite(positions[i]))
       fail(at + ": POSITION of vertex " + str(i / 3) + " is " + (std::isnan(positions[i]) ? "NaN" : "infinite"));
-  std::vector<double> normals =
+  normals =
       readAttribute(prim, "NORMAL", TINYGLTF_TYPE_VEC3, attributeFormats(VertexAttribute::Normal, quantized_), vertexCount, at);
   // The pose (gltf_animation.cpp): morph targets blended, then skinned meshes placed by their joints
-  // (world space; xf is then the identity). mirrored[v]: vertex v's skin matrix mirrors.
-  std::vector<bool> mirrored;
+  // (world space; xf is then the identity).
   if (pose.posed()) {
     morphPrimitive(prim, pose, vertexCount, positions, normals, at);
-    if (pose.skin >= 0) skinPrimitive(prim, pose.skin, vertexCount, positions, normals, mirrored, at);
+    if (pose.skin >= 0) skinPrimitive(prim, pose.skin, vertexCount, positions, normals, v.mirrored, at);
     for (std::size_t i = 0; i < positions.size(); ++i)
       if (!std::isfinite(positions[i])) fail(at + ": a posed vertex position is not finite");
   }
   // Each vertex's world-space normal as its octahedral word (Triangle::normalWord), encoded once per
   // vertex rather than once per corner (a closed mesh has ~6 corners per vertex); kOctNoNormal marks
   // a zero or non-finite one (octEncode never gives it for a unit vector).
-  std::vector<std::uint32_t> normalWords(normals.empty() ? 0 : vertexCount);
+  std::vector<std::uint32_t>& normalWords = v.normalWords;
+  normalWords.resize(normals.empty() ? 0 : vertexCount);
   for (std::size_t i = 0; i < normalWords.size(); ++i) {
     const glm::dvec3 nw = xf.normal * glm::dvec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
     const double len = glm::length(nw);
     normalWords[i] = !(len > 1e-20) || !std::isfinite(len) ? kOctNoNormal : octEncode(glm::vec3(nw / len));
   }
+}
 
+// The primitive's vertex indices (from the Draco data when `draco` is given), each checked against the
+// vertex count; 0, 1, 2, ... without an index accessor.
+std::vector<std::uint32_t> SceneBuilder::readIndices(const tinygltf::Primitive& prim, DracoPrimitive* draco,
+                                                     std::size_t vertexCount, const std::string& at) {
   std::vector<std::uint32_t> indices;
-  if (compressed || prim.indices >= 0) {
+  if (draco || prim.indices >= 0) {
     std::vector<double> raw;
-    if (compressed) {
+    if (draco) {
       if (prim.indices >= 0)  // the accessor still declares the index type
         checkedAccessor(prim.indices, TINYGLTF_TYPE_SCALAR, kIndexFormats, at + " indices");
-      raw = std::move(draco.indices);
+      raw = std::move(draco->indices);
     } else {
       raw = readAccessor(prim.indices, TINYGLTF_TYPE_SCALAR, kIndexFormats, at + " indices");
     }
@@ -508,71 +549,62 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     indices.resize(vertexCount);
     for (std::size_t i = 0; i < vertexCount; ++i) indices[i] = std::uint32_t(i);
   }
+  return indices;
+}
 
-  std::uint32_t material;
+// The primitive's material index, or the default material when it names none.
+std::uint32_t SceneBuilder::primitiveMaterial(const tinygltf::Primitive& prim, const std::string& at) {
   if (prim.material >= 0) {
     if (std::size_t(prim.material) >= model_.materials.size())
       fail(at + ".material is " + str(std::uint64_t(prim.material)) + ", but the file has " +
            str(model_.materials.size()) + " materials");
-    material = std::uint32_t(prim.material);
-  } else {
-    material = defaultMaterial(at);
+    return std::uint32_t(prim.material);
   }
+  return defaultMaterial(at);
+}
+
+// The UVs, COLOR_0 and TANGENT the material uses.
+void SceneBuilder::readSurfaceAttributes(const tinygltf::Primitive& prim, std::uint32_t material, const MeshPose& pose,
+                                         const std::string& at, PrimitiveVertices& v) {
+  const std::size_t vertexCount = v.count;
   // The UV set the material's textures read (TEXCOORD_0 unless they all name TEXCOORD_1).
   const std::string uvName = scene_.materials[material].texCoord == 1 && prim.attributes.count("TEXCOORD_1")
                                  ? "TEXCOORD_1" : "TEXCOORD_0";
   if (scene_.materials[material].texCoord == 1 && uvName != "TEXCOORD_1")
     warn(at + ": its material's textures read TEXCOORD_1, which the primitive lacks; TEXCOORD_0 is used");
-  const std::vector<double> uvs =
+  v.uvs =
       readAttribute(prim, uvName.c_str(), TINYGLTF_TYPE_VEC2, attributeFormats(VertexAttribute::Texcoord, quantized_), vertexCount, at);
-  for (std::size_t i = 0; i < uvs.size(); ++i)
-    if (!std::isfinite(uvs[i])) fail(at + ": " + uvName + " of vertex " + str(i / 2) + " is not finite");
+  for (std::size_t i = 0; i < v.uvs.size(); ++i)
+    if (!std::isfinite(v.uvs[i])) fail(at + ": " + uvName + " of vertex " + str(i / 2) + " is not finite");
   // COLOR_0 (VEC3 or VEC4: float, normalized unsigned byte or short) multiplies the base colour and,
   // its alpha, the opacity; kept per triangle only once some primitive has it.
-  std::vector<double> colors;
-  int colorComponents = 0;
   if (const auto c = prim.attributes.find("COLOR_0"); c != prim.attributes.end()) {
     const int type = c->second >= 0 && std::size_t(c->second) < model_.accessors.size() &&
                              model_.accessors[std::size_t(c->second)].type == TINYGLTF_TYPE_VEC3
                          ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4;
-    colorComponents = type == TINYGLTF_TYPE_VEC3 ? 3 : 4;
-    colors = readAttribute(prim, "COLOR_0", type, attributeFormats(VertexAttribute::Color, quantized_), vertexCount, at);
-    for (std::size_t i = 0; i < colors.size(); ++i)
-      if (!std::isfinite(colors[i])) fail(at + ": COLOR_0 of vertex " + str(i / std::size_t(colorComponents)) + " is not finite");
+    v.colorComponents = type == TINYGLTF_TYPE_VEC3 ? 3 : 4;
+    v.colors = readAttribute(prim, "COLOR_0", type, attributeFormats(VertexAttribute::Color, quantized_), vertexCount, at);
+    for (std::size_t i = 0; i < v.colors.size(); ++i)
+      if (!std::isfinite(v.colors[i]))
+        fail(at + ": COLOR_0 of vertex " + str(i / std::size_t(v.colorComponents)) + " is not finite");
     if (!keepColors_) scene_.colors.resize(scene_.triangles.size());  // white before the first
     keepColors_ = true;
   }
   // TANGENT (VEC4: xyz and the bitangent's sign) orients the material's normal map, when it has one.
-  std::vector<double> tangents;
   // A skinned or morphed pose moves the surface under the file's tangents, which are not posed: the
   // normal map then takes the posed triangle's dp/du.
   const bool posedShape = pose.posed() && (pose.skin >= 0 || !prim.targets.empty());
   if (scene_.materials[material].normalTexture >= 0 && prim.attributes.count("TANGENT") && !posedShape) {
-    tangents = readAttribute(prim, "TANGENT", TINYGLTF_TYPE_VEC4, attributeFormats(VertexAttribute::Tangent, quantized_),
-                             vertexCount, at);
+    v.tangents = readAttribute(prim, "TANGENT", TINYGLTF_TYPE_VEC4, attributeFormats(VertexAttribute::Tangent, quantized_),
+                               vertexCount, at);
     if (!keepTangents_) scene_.tangents.resize(scene_.triangles.size());  // none before the first
     keepTangents_ = true;
   }
-  const auto tangentAt = [&](std::size_t i) -> glm::vec4 {  // world space; 0 where unusable
-    const glm::dvec3 t = glm::dmat3(xf.world) * glm::dvec3(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
-    const double len = glm::length(t);
-    if (!(len > 1e-20) || !std::isfinite(len) || !std::isfinite(tangents[4 * i + 3])) return glm::vec4(0.0f);
-    // A mirroring transform turns cross(normal, tangent) around: the sign follows the determinant.
-    const float w = (tangents[4 * i + 3] < 0.0) != xf.flip ? -1.0f : 1.0f;
-    return glm::vec4(glm::vec3(t / len), w);
-  };
+}
 
-  // Corner triples in glTF's counter-clockwise order for each mode (glTF 3.7.2.1).
-  const std::size_t n = indices.size();
-  auto corner = [&](std::size_t t, int k) -> std::uint32_t {
-    if (prim.mode == TINYGLTF_MODE_TRIANGLES) return indices[3 * t + std::size_t(k)];
-    if (prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-      const std::size_t odd = t % 2;
-      const std::size_t offset[3] = {0, 1 + odd, 2 - odd};
-      return indices[t + offset[k]];
-    }
-    return k == 2 ? indices[0] : indices[t + 1 + std::size_t(k)];  // fan: (i+1, i+2, 0)
-  };
+// The number of triangles `indexCount` indices make in the primitive's mode, counted against --max-triangles.
+std::size_t SceneBuilder::countTriangles(const tinygltf::Primitive& prim, std::size_t indexCount, const std::string& at) {
+  const std::size_t n = indexCount;
   std::size_t triangles = 0;
   if (prim.mode == TINYGLTF_MODE_TRIANGLES) {
     triangles = n / 3;
@@ -584,11 +616,40 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
   candidates_ += triangles;  // counted before degenerate ones are dropped, so work stays bounded
   if (candidates_ > options_.maxTriangles)
     fail("the scene has more than " + str(options_.maxTriangles) + " triangles (use --max-triangles to raise the limit)");
+  return triangles;
+}
 
+// The primitive's triangles in world space (relative to origin_), with their UVs, colours and tangents;
+// degenerate ones dropped, flat normals where a corner has none.
+void SceneBuilder::addTriangles(const tinygltf::Primitive& prim, const std::vector<std::uint32_t>& indices,
+                                std::size_t triangles, const PrimitiveVertices& v, std::uint32_t material,
+                                const NodeTransform& xf, const std::string& at) {
+  const std::vector<double>& positions = v.positions;
+  const std::vector<double>& uvs = v.uvs;
+  const std::vector<double>& colors = v.colors;
+  const std::vector<double>& tangents = v.tangents;
+  const auto tangentAt = [&](std::size_t i) -> glm::vec4 {  // world space; 0 where unusable
+    const glm::dvec3 t = glm::dmat3(xf.world) * glm::dvec3(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
+    const double len = glm::length(t);
+    if (!(len > 1e-20) || !std::isfinite(len) || !std::isfinite(tangents[4 * i + 3])) return glm::vec4(0.0f);
+    // A mirroring transform turns cross(normal, tangent) around: the sign follows the determinant.
+    const float w = (tangents[4 * i + 3] < 0.0) != xf.flip ? -1.0f : 1.0f;
+    return glm::vec4(glm::vec3(t / len), w);
+  };
+  // Corner triples in glTF's counter-clockwise order for each mode (glTF 3.7.2.1).
+  auto corner = [&](std::size_t t, int k) -> std::uint32_t {
+    if (prim.mode == TINYGLTF_MODE_TRIANGLES) return indices[3 * t + std::size_t(k)];
+    if (prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      const std::size_t odd = t % 2;
+      const std::size_t offset[3] = {0, 1 + odd, 2 - odd};
+      return indices[t + offset[k]];
+    }
+    return k == 2 ? indices[0] : indices[t + 1 + std::size_t(k)];  // fan: (i+1, i+2, 0)
+  };
   for (std::size_t t = 0; t < triangles; ++t) {
-    std::uint32_t v[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};
+    std::uint32_t c[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};
     // A negative determinant (the node's, or the skin's at the first corner): restore counter-clockwise fronts.
-    if (xf.flip != (!mirrored.empty() && mirrored[v[0]])) std::swap(v[1], v[2]);
+    if (xf.flip != (!v.mirrored.empty() && v.mirrored[c[0]])) std::swap(c[1], c[2]);
     Triangle tri;
     TriangleUv uv;
     TriangleColors color;
@@ -596,13 +657,13 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
     tri.material = material;
     bool finite = true;
     for (int k = 0; k < 3; ++k) {
-      const std::size_t i = v[k];
+      const std::size_t i = c[k];
       const glm::dvec4 p = xf.world * glm::dvec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0);
       tri.p[k] = glm::vec3(glm::dvec3(p) - origin_);
       finite = finite && std::isfinite(tri.p[k].x) && std::isfinite(tri.p[k].y) && std::isfinite(tri.p[k].z);
       uv.uv[k] = uvs.empty() ? glm::vec2(0.0f) : glm::vec2(float(uvs[2 * i]), float(uvs[2 * i + 1]));
       if (!colors.empty()) {
-        const std::size_t cn = std::size_t(colorComponents);
+        const std::size_t cn = std::size_t(v.colorComponents);
         color.color[k] = glm::vec4(float(colors[cn * i]), float(colors[cn * i + 1]), float(colors[cn * i + 2]),
                                    cn == 4 ? float(colors[cn * i + 3]) : 1.0f);
       }
@@ -615,9 +676,9 @@ void SceneBuilder::addPrimitive(const tinygltf::Primitive& prim, const NodeTrans
       ++degenerate_;
       continue;
     }
-    bool smooth = !normalWords.empty();
+    bool smooth = !v.normalWords.empty();
     for (int k = 0; k < 3 && smooth; ++k) {
-      tri.normalWord[k] = normalWords[v[k]];
+      tri.normalWord[k] = v.normalWords[c[k]];
       if (tri.normalWord[k] == kOctNoNormal) {
         smooth = false;
         ++badNormals_;
