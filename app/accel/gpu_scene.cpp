@@ -212,6 +212,138 @@ void packMaterialsAndTextures(const Scene& scene, GpuScene& g) {
   }
 
 }
+
+// packInstancedScene's steps, in order.
+
+// Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
+// the light-leaf table): emissiveIndex per Scene triangle (kInvalidIndex: not emissive), and the
+// count per mesh.
+void numberMeshEmitters(const Scene& scene, std::vector<std::uint32_t>& emissiveIndex,
+                        std::vector<std::uint32_t>& meshEmitters) {
+  emissiveIndex.assign(scene.triangles.size(), gpu::kInvalidIndex);
+  meshEmitters.assign(scene.meshes.size(), 0);
+  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const MeshRange& r = scene.meshes[mi];
+    for (std::uint32_t i = r.firstTriangle; i < r.firstTriangle + r.triangleCount; ++i)
+      if (scene.materials[scene.triangles[i].material].isEmissive()) emissiveIndex[i] = meshEmitters[mi]++;
+  }
+}
+
+// The emissive and specular (caster) triangles of every instance are flattened on the host
+// (transiently), bounded so that many placed emitters or glass objects cannot exhaust the host.
+// Casters only speed up caustics: skipped beyond the bound. Sets g.casters and g.emitterSphere;
+// returns the world-space emissive triangles, `source` naming each one's instance and stored triangle.
+Scene flattenCastersAndLights(const Scene& scene, GpuScene& g, std::vector<InstancedTriangle>& source) {
+  std::vector<bool> emissive(scene.materials.size()), specular(scene.materials.size());
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    emissive[m] = scene.materials[m].isEmissive();
+    specular[m] = scene.materials[m].metallic > 0.0f || scene.materials[m].transmission > 0.0f;
+  }
+  constexpr std::uint64_t kMaxFlattened = 1u << 22;
+  if (placedTriangles(scene, specular) <= kMaxFlattened)
+    g.casters = findCausticCasters(flattenedSubset(scene, specular), CAUSTICA_MAX_CASTERS);
+  if (placedTriangles(scene, emissive) > kMaxFlattened)
+    throw Error(scene.path + ": the instances place " + std::to_string(placedTriangles(scene, emissive)) +
+                " emissive triangles; the light tree takes at most " + std::to_string(kMaxFlattened) +
+                " of an instanced scene (load it with --instances off)");
+  Scene lights = flattenedSubset(scene, emissive, &source);
+  g.emitterSphere = emitterBoundingSphere(lights);
+  return lights;
+}
+
+// Stored triangles: object-space TriGeom (bvh.tris, moved into g) and TriShade words, in bvh.tris
+// order. Returns each Scene triangle's stored index (kInvalidIndex: not stored).
+std::vector<std::uint32_t> packStoredTriangles(const Scene& scene, InstancedBvh& bvh,
+                                               const std::vector<std::uint32_t>& emissiveIndex, GpuScene& g) {
+  g.triangleCount = bvh.tris.size();
+  g.triGeom = std::move(bvh.tris);
+  g.triShade.resize(g.triangleCount * g.triShadeStride);
+  std::vector<std::uint32_t> storedIndex(scene.triangles.size(), gpu::kInvalidIndex);
+  for (std::size_t x = 0; x < g.triangleCount; ++x) {
+    const std::uint32_t i = bvh.triSource[x];
+    storedIndex[i] = static_cast<std::uint32_t>(x);
+    g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
+    writeTriShade(scene, i, g.triShadeLayout, g.triShade.data() + x * g.triShadeStride);
+  }
+  return storedIndex;
+}
+
+// Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
+void packInstancedEmitters(const Scene& scene, const Scene& lights, const std::vector<InstancedTriangle>& source,
+                           const std::vector<std::uint32_t>& storedIndex, GpuScene& g) {
+  std::vector<LightTreeItem> lightItems;
+  double totalWeight = 0.0;
+  for (std::size_t e = 0; e < lights.triangles.size(); ++e) {
+    const Triangle& tri = lights.triangles[e];
+    const Material& m = scene.materials[tri.material];
+    if (!m.isEmissive()) continue;
+    const double w = emitterWeight(m, tri.p);
+    if (w == 0.0) continue;
+    totalWeight += w;
+    lightItems.push_back(emitterItem(storedIndex[source[e].triangle], tri.p, w, m.doubleSided));
+    lightItems.back().instance = source[e].instance;
+  }
+  g.emitterCount = lightItems.size();
+  g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
+  std::vector<std::uint32_t>().swap(g.lightTree.leafOf);  // per stored triangle: meaningless here
+  g.totalEmitterWeight = static_cast<float>(totalWeight);
+  g.totalPower = kPi * totalWeight;
+}
+
+// The light-leaf table: per instance of an emissive mesh, its emitters' leaves in emissiveIndex order;
+// leafBase[i]: where instance i's entries start.
+std::vector<std::uint32_t> lightLeafTable(const Scene& scene, const InstancedBvh& bvh, const GpuScene& g,
+                                          const std::vector<std::uint32_t>& emissiveIndex,
+                                          const std::vector<std::uint32_t>& meshEmitters,
+                                          std::vector<std::uint32_t>& leafBase) {
+  leafBase.assign(scene.instances.size(), 0);
+  std::size_t tableSize = 0;
+  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+    leafBase[i] = static_cast<std::uint32_t>(tableSize);
+    tableSize += meshEmitters[scene.instances[i].mesh];
+  }
+  std::vector<std::uint32_t> table(tableSize, gpu::kInvalidIndex);
+  for (std::size_t n = 0; n < g.lightTree.nodes.size(); ++n) {
+    const glm::uvec4& link = g.lightTree.nodes[n].link;
+    if ((link.y & gpu::kLightNodeLeaf) == 0u) continue;
+    const std::uint32_t inst = link.y >> gpu::kLightNodeInstanceShift;
+    table[leafBase[inst] + emissiveIndex[bvh.triSource[link.x]]] = static_cast<std::uint32_t>(n);
+  }
+  return table;
+}
+
+// Nodes (bvh.nodes, moved into g), then InstanceRecords (top-level leaf order), InstanceShades
+// (Scene::instances order), the light-leaf table.
+void packInstanceBlocks(const Scene& scene, InstancedBvh& bvh, const std::vector<std::uint32_t>& leafBase,
+                        const std::vector<std::uint32_t>& table, GpuScene& g) {
+  g.nodes = std::move(bvh.nodes);
+  g.instanceCount = static_cast<std::uint32_t>(scene.instances.size());
+  g.instanceRecordBase = static_cast<std::uint32_t>(g.nodes.size());
+  const auto append = [&](const void* data, std::size_t bytes) {
+    const std::size_t first = g.nodes.size();
+    g.nodes.resize(first + (bytes + sizeof(gpu::BvhNode) - 1) / sizeof(gpu::BvhNode), gpu::BvhNode{});
+    if (bytes) std::memcpy(static_cast<void*>(g.nodes.data() + first), data, bytes);
+  };
+  append(bvh.instances.data(), bvh.instances.size() * sizeof(gpu::InstanceRecord));
+  std::vector<gpu::InstanceShade> shades(scene.instances.size());
+  glm::dmat4 rebase0(1.0);
+  rebase0[3] = glm::dvec4(-scene.origin, 1.0);
+  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& in = scene.instances[i];
+    const glm::dmat4 w = rebase0 * in.world;
+    gpu::InstanceShade& sh = shades[i];
+    sh.row0 = glm::vec4(w[0][0], w[1][0], w[2][0], w[3][0]);
+    sh.row1 = glm::vec4(w[0][1], w[1][1], w[2][1], w[3][1]);
+    sh.row2 = glm::vec4(w[0][2], w[1][2], w[2][2], w[3][2]);
+    sh.lightLeafBase = leafBase[i];
+    sh.flags = glm::determinant(glm::dmat3(in.world)) < 0.0 ? gpu::kInstanceMirrored : 0u;
+  }
+  g.instancedTriangles = instancedTriangleCount(scene);
+  append(shades.data(), shades.size() * sizeof(gpu::InstanceShade));
+  g.lightLeafTableTexel = static_cast<std::uint32_t>(g.nodes.size() * (sizeof(gpu::BvhNode) / 16));
+  append(table.data(), table.size() * sizeof(std::uint32_t));
+  std::vector<gpu::InstanceRecord>().swap(bvh.instances);
+}
 }  // namespace
 
 GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
@@ -250,110 +382,17 @@ GpuScene packInstancedScene(const Scene& scene, InstancedBvh& bvh) {
   if (bvh.triSource.size() != bvh.tris.size()) throw Error("internal: packInstancedScene without triSource");
   GpuScene g;
   setTriShadeLayout(scene, g);
-  // Emissive triangles are numbered within their mesh (TriGeom.v1.w = that number + 1, the order of
-  // the light-leaf table).
-  std::vector<std::uint32_t> emissiveIndex(scene.triangles.size(), gpu::kInvalidIndex);
-  std::vector<std::uint32_t> meshEmitters(scene.meshes.size(), 0);
-  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    const MeshRange& r = scene.meshes[mi];
-    for (std::uint32_t i = r.firstTriangle; i < r.firstTriangle + r.triangleCount; ++i)
-      if (scene.materials[scene.triangles[i].material].isEmissive()) emissiveIndex[i] = meshEmitters[mi]++;
-  }
-  // The emissive and specular (caster) triangles of every instance are flattened on the host
-  // (transiently), bounded so that many placed emitters or glass objects cannot exhaust the host.
-  // Casters only speed up caustics: skipped beyond the bound.
-  std::vector<bool> emissive(scene.materials.size()), specular(scene.materials.size());
-  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
-    emissive[m] = scene.materials[m].isEmissive();
-    specular[m] = scene.materials[m].metallic > 0.0f || scene.materials[m].transmission > 0.0f;
-  }
-  constexpr std::uint64_t kMaxFlattened = 1u << 22;
-  if (placedTriangles(scene, specular) <= kMaxFlattened)
-    g.casters = findCausticCasters(flattenedSubset(scene, specular), CAUSTICA_MAX_CASTERS);
-  if (placedTriangles(scene, emissive) > kMaxFlattened)
-    throw Error(scene.path + ": the instances place " + std::to_string(placedTriangles(scene, emissive)) +
-                " emissive triangles; the light tree takes at most " + std::to_string(kMaxFlattened) +
-                " of an instanced scene (load it with --instances off)");
+  std::vector<std::uint32_t> emissiveIndex, meshEmitters;
+  numberMeshEmitters(scene, emissiveIndex, meshEmitters);
   std::vector<InstancedTriangle> source;
-  const Scene lights = flattenedSubset(scene, emissive, &source);
-  g.emitterSphere = emitterBoundingSphere(lights);
+  const Scene lights = flattenCastersAndLights(scene, g, source);
   packEnvironment(scene, g);
   packMaterialsAndTextures(scene, g);
-
-  // Stored triangles: object-space TriGeom (bvh.tris) and TriShade words, in bvh.tris order.
-  g.triangleCount = bvh.tris.size();
-  g.triGeom = std::move(bvh.tris);
-  g.triShade.resize(g.triangleCount * g.triShadeStride);
-  std::vector<std::uint32_t> storedIndex(scene.triangles.size(), gpu::kInvalidIndex);
-  for (std::size_t x = 0; x < g.triangleCount; ++x) {
-    const std::uint32_t i = bvh.triSource[x];
-    storedIndex[i] = static_cast<std::uint32_t>(x);
-    g.triGeom[x].v1.w = glm::uintBitsToFloat(emissiveIndex[i] == gpu::kInvalidIndex ? 0u : emissiveIndex[i] + 1u);
-    writeTriShade(scene, i, g.triShadeLayout, g.triShade.data() + x * g.triShadeStride);
-  }
-
-  // Emitters: every emissive triangle of every instance, in world space as flattenInstances makes it.
-  std::vector<LightTreeItem> lightItems;
-  double totalWeight = 0.0;
-  for (std::size_t e = 0; e < lights.triangles.size(); ++e) {
-    const Triangle& tri = lights.triangles[e];
-    const Material& m = scene.materials[tri.material];
-    if (!m.isEmissive()) continue;
-    const double w = emitterWeight(m, tri.p);
-    if (w == 0.0) continue;
-    totalWeight += w;
-    lightItems.push_back(emitterItem(storedIndex[source[e].triangle], tri.p, w, m.doubleSided));
-    lightItems.back().instance = source[e].instance;
-  }
-  g.emitterCount = lightItems.size();
-  g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
-  std::vector<std::uint32_t>().swap(g.lightTree.leafOf);  // per stored triangle: meaningless here
-  g.totalEmitterWeight = static_cast<float>(totalWeight);
-  g.totalPower = kPi * totalWeight;
-
-  // The light-leaf table: per instance of an emissive mesh, its emitters' leaves in emissiveIndex order.
-  std::vector<std::uint32_t> leafBase(scene.instances.size(), 0);
-  std::size_t tableSize = 0;
-  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
-    leafBase[i] = static_cast<std::uint32_t>(tableSize);
-    tableSize += meshEmitters[scene.instances[i].mesh];
-  }
-  std::vector<std::uint32_t> table(tableSize, gpu::kInvalidIndex);
-  for (std::size_t n = 0; n < g.lightTree.nodes.size(); ++n) {
-    const glm::uvec4& link = g.lightTree.nodes[n].link;
-    if ((link.y & gpu::kLightNodeLeaf) == 0u) continue;
-    const std::uint32_t inst = link.y >> gpu::kLightNodeInstanceShift;
-    table[leafBase[inst] + emissiveIndex[bvh.triSource[link.x]]] = static_cast<std::uint32_t>(n);
-  }
-
-  // Nodes, then InstanceRecords (top-level leaf order), InstanceShades (Scene::instances order), the table.
-  g.nodes = std::move(bvh.nodes);
-  g.instanceCount = static_cast<std::uint32_t>(scene.instances.size());
-  g.instanceRecordBase = static_cast<std::uint32_t>(g.nodes.size());
-  const auto append = [&](const void* data, std::size_t bytes) {
-    const std::size_t first = g.nodes.size();
-    g.nodes.resize(first + (bytes + sizeof(gpu::BvhNode) - 1) / sizeof(gpu::BvhNode), gpu::BvhNode{});
-    if (bytes) std::memcpy(static_cast<void*>(g.nodes.data() + first), data, bytes);
-  };
-  append(bvh.instances.data(), bvh.instances.size() * sizeof(gpu::InstanceRecord));
-  std::vector<gpu::InstanceShade> shades(scene.instances.size());
-  glm::dmat4 rebase0(1.0);
-  rebase0[3] = glm::dvec4(-scene.origin, 1.0);
-  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
-    const Instance& in = scene.instances[i];
-    const glm::dmat4 w = rebase0 * in.world;
-    gpu::InstanceShade& sh = shades[i];
-    sh.row0 = glm::vec4(w[0][0], w[1][0], w[2][0], w[3][0]);
-    sh.row1 = glm::vec4(w[0][1], w[1][1], w[2][1], w[3][1]);
-    sh.row2 = glm::vec4(w[0][2], w[1][2], w[2][2], w[3][2]);
-    sh.lightLeafBase = leafBase[i];
-    sh.flags = glm::determinant(glm::dmat3(in.world)) < 0.0 ? gpu::kInstanceMirrored : 0u;
-  }
-  g.instancedTriangles = instancedTriangleCount(scene);
-  append(shades.data(), shades.size() * sizeof(gpu::InstanceShade));
-  g.lightLeafTableTexel = static_cast<std::uint32_t>(g.nodes.size() * (sizeof(gpu::BvhNode) / 16));
-  append(table.data(), table.size() * sizeof(std::uint32_t));
-  std::vector<gpu::InstanceRecord>().swap(bvh.instances);
+  const std::vector<std::uint32_t> storedIndex = packStoredTriangles(scene, bvh, emissiveIndex, g);
+  packInstancedEmitters(scene, lights, source, storedIndex, g);
+  std::vector<std::uint32_t> leafBase;
+  const std::vector<std::uint32_t> table = lightLeafTable(scene, bvh, g, emissiveIndex, meshEmitters, leafBase);
+  packInstanceBlocks(scene, bvh, leafBase, table, g);
   return g;
 }
 

@@ -197,6 +197,16 @@ class SceneBuilder {
   // ---- materials (gltf_materials.cpp) ----
   double unit(double v, const std::string& what);
   Material convertMaterial(int index);
+  // convertMaterial's steps, in order (gltf_materials.cpp): base colour, metal/roughness, normal map and
+  // opacity; emission; transmission, ior and volume (`ignored` collects what is not rendered);
+  // the dielectric specular layer; clear coat; sheen; the one UV set the material's textures read.
+  void convertBasePbr(const tinygltf::Material& m, const std::string& at, Material& out);
+  void convertEmission(const tinygltf::Material& m, const std::string& at, Material& out);
+  void convertTransmission(const tinygltf::Material& m, const std::string& at, Material& out, std::string& ignored);
+  void convertSpecular(const tinygltf::Material& m, const std::string& at, Material& out);
+  void convertClearcoat(const tinygltf::Material& m, const std::string& at, Material& out);
+  void convertSheen(const tinygltf::Material& m, const std::string& at, Material& out);
+  void chooseMaterialTexCoord(const std::string& at, Material& out);
   std::set<int> materialTexCoords_;  // UV sets the textures of the material being converted name
   int texture(const tinygltf::TextureInfo& info, const std::string& at);
   int texture(const tinygltf::NormalTextureInfo& info, const std::string& at);

@@ -40,6 +40,11 @@ void makeUnlit(Material& m) {
   m = u;
 }
 
+// Adds `what` to a material's list of things not rendered (`ignored`, comma-separated) if present.
+void ignore(std::string& ignored, bool present, const char* what) {
+  if (present) ignored += (ignored.empty() ? "" : ", ") + std::string(what);
+}
+
 void wrapMode(int mode, bool& repeat, bool& mirror) {
   repeat = mode != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
   mirror = mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT;
@@ -117,8 +122,29 @@ Material SceneBuilder::convertMaterial(int index) {
   Material out;
   materialTexCoords_.clear();
   out.name = m.name.empty() ? "material " + str(std::uint64_t(index)) : m.name;
-  const auto& pbr = m.pbrMetallicRoughness;
+  convertBasePbr(m, at, out);
+  convertEmission(m, at, out);
+  out.doubleSided = m.doubleSided;
 
+  std::string ignored;  // what the material has that is not rendered, for one notRendered line
+  ignore(ignored, m.occlusionTexture.index >= 0, "occlusionTexture (ambient occlusion is what a path tracer computes)");
+  convertTransmission(m, at, out, ignored);
+  convertSpecular(m, at, out);
+  convertClearcoat(m, at, out);
+  convertSheen(m, at, out);
+  if (const tinygltf::Value* d = extension(m.extensions, "KHR_materials_dispersion")) {
+    const double dispersion = extNumber(d, "dispersion", 0.0);
+    if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
+    else out.dispersion = float(dispersion);
+  }
+  if (extension(m.extensions, "KHR_materials_unlit")) makeUnlit(out);
+  if (!ignored.empty()) notRendered(at + " '" + oneLine(out.name) + "': " + ignored);
+  chooseMaterialTexCoord(at, out);
+  return out;
+}
+
+void SceneBuilder::convertBasePbr(const tinygltf::Material& m, const std::string& at, Material& out) {
+  const auto& pbr = m.pbrMetallicRoughness;
   glm::dvec4 base(1.0);
   for (std::size_t c = 0; c < 4 && c < pbr.baseColorFactor.size(); ++c)
     base[int(c)] = unit(pbr.baseColorFactor[c], at + ".baseColorFactor[" + str(c) + "]");
@@ -145,7 +171,9 @@ Material SceneBuilder::convertMaterial(int index) {
   out.baseColor = glm::vec4(base);
   out.alphaFromVertices = m.alphaMode == "BLEND" || m.alphaMode == "MASK";
   out.alphaFromTexture = out.baseColorTexture >= 0 && out.alphaFromVertices;
+}
 
+void SceneBuilder::convertEmission(const tinygltf::Material& m, const std::string& at, Material& out) {
   // Emission: emissiveFactor x KHR_materials_emissive_strength = radiance (linear).
   glm::dvec3 emissive(0.0);
   for (std::size_t c = 0; c < 3 && c < m.emissiveFactor.size(); ++c) {
@@ -164,14 +192,10 @@ Material SceneBuilder::convertMaterial(int index) {
   if (!std::isfinite(out.emission.r) || !std::isfinite(out.emission.g) || !std::isfinite(out.emission.b))
     fail(at + ": emitted radiance overflows a float");
   out.emissiveTexture = texture(m.emissiveTexture, at + ".emissiveTexture");
-  out.doubleSided = m.doubleSided;
+}
 
-  std::string ignored;
-  const auto ignore = [&](bool present, const char* what) {
-    if (present) ignored += (ignored.empty() ? "" : ", ") + std::string(what);
-  };
-  ignore(m.occlusionTexture.index >= 0, "occlusionTexture (ambient occlusion is what a path tracer computes)");
-
+void SceneBuilder::convertTransmission(const tinygltf::Material& m, const std::string& at, Material& out,
+                                       std::string& ignored) {
   if (const tinygltf::Value* t = extension(m.extensions, "KHR_materials_transmission")) {
     out.transmission = float(unit(extNumber(t, "transmissionFactor", 0.0), at + ".transmissionFactor"));
     if (out.transmission > 0.0f) out.transmissionTexture = extTexture(t, "transmissionTexture", at);
@@ -183,7 +207,7 @@ Material SceneBuilder::convertMaterial(int index) {
   }
   if (const tinygltf::Value* v = extension(m.extensions, "KHR_materials_volume")) {
     // thicknessFactor is ignored: the ray tracer follows the real geometry through the volume.
-    ignore(extHas(v, "thicknessTexture"), "thicknessTexture");
+    ignore(ignored, extHas(v, "thicknessTexture"), "thicknessTexture");
     if (extHas(v, "attenuationColor") && v->Get("attenuationColor").ArrayLen() == 3)
       for (int c = 0; c < 3; ++c)
         out.attenuationColor[c] = float(unit(v->Get("attenuationColor").Get(c).GetNumberAsDouble(),
@@ -192,72 +216,75 @@ Material SceneBuilder::convertMaterial(int index) {
     if (!(distance > 0.0)) warn(at + ": attenuationDistance " + num(distance) + " is not positive; no absorption");
     else out.attenuationDistance = float(distance);
   }
-  // The dielectric specular layer over the diffuse base (glTF Appendix B fresnel_mix, with
-  // KHR_materials_specular): F0 = min(((ior - 1) / (ior + 1))^2 specularColorFactor, 1) specularFactor,
-  // F90 = specularFactor.
-  {
-    double specularFactor = 1.0;
-    glm::dvec3 specularColor(1.0);
-    if (const tinygltf::Value* sp = extension(m.extensions, "KHR_materials_specular")) {
-      specularFactor = unit(extNumber(sp, "specularFactor", 1.0), at + ".specularFactor");
-      if (extHas(sp, "specularColorFactor") && sp->Get("specularColorFactor").ArrayLen() == 3)
-        for (int c = 0; c < 3; ++c) {
-          const tinygltf::Value& v = sp->Get("specularColorFactor").Get(c);
-          double x = v.IsNumber() ? v.GetNumberAsDouble() : 1.0;
-          if (!(x >= 0.0) || !std::isfinite(x)) {
-            warn(at + ".specularColorFactor[" + str(std::uint64_t(c)) + "] is not a finite number >= 0; using 1");
-            x = 1.0;
-          }
-          specularColor[c] = x;
-        }
-      // Textures only where a specular layer can exist (the dielectric base; not a full metal or glass).
-      if (out.metallic < 1.0f && out.transmission < 1.0f) {
-        out.specularTexture = extTexture(sp, "specularTexture", at);
-        out.specularColorTexture = extTexture(sp, "specularColorTexture", at);
-      }
-    }
-    const double r = (double(out.ior) - 1.0) / (double(out.ior) + 1.0);
-    out.specularF0 = glm::vec3(glm::min(r * r * specularColor, glm::dvec3(1.0)) * specularFactor);
-    out.specularF90 = float(specularFactor);
-    out.specularColorFactor = glm::vec3(specularColor);
-    out.specularFactor = float(specularFactor);
-    // A specular texture can raise F90 from 0 only if the factor does: specularFactor 0 stays Lambertian.
-    if (out.specularF90 == 0.0f) out.specularTexture = out.specularColorTexture = -1;
-  }
-  if (const tinygltf::Value* c = extension(m.extensions, "KHR_materials_clearcoat")) {
-    out.clearcoat = float(unit(extNumber(c, "clearcoatFactor", 0.0), at + ".clearcoatFactor"));
-    out.clearcoatRoughness = float(unit(extNumber(c, "clearcoatRoughnessFactor", 0.0), at + ".clearcoatRoughnessFactor"));
-    if (out.clearcoat > 0.0f) {
-      out.clearcoatTexture = extTexture(c, "clearcoatTexture", at);
-      out.clearcoatRoughnessTexture = extTexture(c, "clearcoatRoughnessTexture", at);
-      out.clearcoatNormalTexture = extTexture(c, "clearcoatNormalTexture", at);
-      if (out.clearcoatNormalTexture >= 0) {
-        out.clearcoatNormalScale = float(extNumber(&c->Get("clearcoatNormalTexture"), "scale", 1.0));
-        if (!std::isfinite(out.clearcoatNormalScale)) fail(at + ".clearcoatNormalTexture.scale is not finite");
-      }
-    }
-  }
-  if (const tinygltf::Value* sh = extension(m.extensions, "KHR_materials_sheen")) {
-    if (extHas(sh, "sheenColorFactor") && sh->Get("sheenColorFactor").ArrayLen() == 3)
+}
+
+// The dielectric specular layer over the diffuse base (glTF Appendix B fresnel_mix, with
+// KHR_materials_specular): F0 = min(((ior - 1) / (ior + 1))^2 specularColorFactor, 1) specularFactor,
+// F90 = specularFactor.
+void SceneBuilder::convertSpecular(const tinygltf::Material& m, const std::string& at, Material& out) {
+  double specularFactor = 1.0;
+  glm::dvec3 specularColor(1.0);
+  if (const tinygltf::Value* sp = extension(m.extensions, "KHR_materials_specular")) {
+    specularFactor = unit(extNumber(sp, "specularFactor", 1.0), at + ".specularFactor");
+    if (extHas(sp, "specularColorFactor") && sp->Get("specularColorFactor").ArrayLen() == 3)
       for (int c = 0; c < 3; ++c) {
-        const tinygltf::Value& v = sh->Get("sheenColorFactor").Get(c);
-        out.sheenColor[c] = float(unit(v.IsNumber() ? v.GetNumberAsDouble() : 0.0,
-                                       at + ".sheenColorFactor[" + str(std::uint64_t(c)) + "]"));
+        const tinygltf::Value& v = sp->Get("specularColorFactor").Get(c);
+        double x = v.IsNumber() ? v.GetNumberAsDouble() : 1.0;
+        if (!(x >= 0.0) || !std::isfinite(x)) {
+          warn(at + ".specularColorFactor[" + str(std::uint64_t(c)) + "] is not a finite number >= 0; using 1");
+          x = 1.0;
+        }
+        specularColor[c] = x;
       }
-    out.sheenRoughness = float(unit(extNumber(sh, "sheenRoughnessFactor", 0.0), at + ".sheenRoughnessFactor"));
-    if (out.hasSheen()) {
-      out.sheenColorTexture = extTexture(sh, "sheenColorTexture", at);
-      out.sheenRoughnessTexture = extTexture(sh, "sheenRoughnessTexture", at);
+    // Textures only where a specular layer can exist (the dielectric base; not a full metal or glass).
+    if (out.metallic < 1.0f && out.transmission < 1.0f) {
+      out.specularTexture = extTexture(sp, "specularTexture", at);
+      out.specularColorTexture = extTexture(sp, "specularColorTexture", at);
     }
   }
-  if (const tinygltf::Value* d = extension(m.extensions, "KHR_materials_dispersion")) {
-    const double dispersion = extNumber(d, "dispersion", 0.0);
-    if (dispersion < 0.0) warn(at + ": dispersion " + num(dispersion) + " is negative; using 0");
-    else out.dispersion = float(dispersion);
+  const double r = (double(out.ior) - 1.0) / (double(out.ior) + 1.0);
+  out.specularF0 = glm::vec3(glm::min(r * r * specularColor, glm::dvec3(1.0)) * specularFactor);
+  out.specularF90 = float(specularFactor);
+  out.specularColorFactor = glm::vec3(specularColor);
+  out.specularFactor = float(specularFactor);
+  // A specular texture can raise F90 from 0 only if the factor does: specularFactor 0 stays Lambertian.
+  if (out.specularF90 == 0.0f) out.specularTexture = out.specularColorTexture = -1;
+}
+
+void SceneBuilder::convertClearcoat(const tinygltf::Material& m, const std::string& at, Material& out) {
+  const tinygltf::Value* c = extension(m.extensions, "KHR_materials_clearcoat");
+  if (!c) return;
+  out.clearcoat = float(unit(extNumber(c, "clearcoatFactor", 0.0), at + ".clearcoatFactor"));
+  out.clearcoatRoughness = float(unit(extNumber(c, "clearcoatRoughnessFactor", 0.0), at + ".clearcoatRoughnessFactor"));
+  if (out.clearcoat > 0.0f) {
+    out.clearcoatTexture = extTexture(c, "clearcoatTexture", at);
+    out.clearcoatRoughnessTexture = extTexture(c, "clearcoatRoughnessTexture", at);
+    out.clearcoatNormalTexture = extTexture(c, "clearcoatNormalTexture", at);
+    if (out.clearcoatNormalTexture >= 0) {
+      out.clearcoatNormalScale = float(extNumber(&c->Get("clearcoatNormalTexture"), "scale", 1.0));
+      if (!std::isfinite(out.clearcoatNormalScale)) fail(at + ".clearcoatNormalTexture.scale is not finite");
+    }
   }
-  if (extension(m.extensions, "KHR_materials_unlit")) makeUnlit(out);
-  if (!ignored.empty()) notRendered(at + " '" + oneLine(out.name) + "': " + ignored);
-  // Triangles carry one UV set, so a material's textures must agree on theirs (TEXCOORD_0 or _1).
+}
+
+void SceneBuilder::convertSheen(const tinygltf::Material& m, const std::string& at, Material& out) {
+  const tinygltf::Value* sh = extension(m.extensions, "KHR_materials_sheen");
+  if (!sh) return;
+  if (extHas(sh, "sheenColorFactor") && sh->Get("sheenColorFactor").ArrayLen() == 3)
+    for (int c = 0; c < 3; ++c) {
+      const tinygltf::Value& v = sh->Get("sheenColorFactor").Get(c);
+      out.sheenColor[c] = float(unit(v.IsNumber() ? v.GetNumberAsDouble() : 0.0,
+                                     at + ".sheenColorFactor[" + str(std::uint64_t(c)) + "]"));
+    }
+  out.sheenRoughness = float(unit(extNumber(sh, "sheenRoughnessFactor", 0.0), at + ".sheenRoughnessFactor"));
+  if (out.hasSheen()) {
+    out.sheenColorTexture = extTexture(sh, "sheenColorTexture", at);
+    out.sheenRoughnessTexture = extTexture(sh, "sheenRoughnessTexture", at);
+  }
+}
+
+// Triangles carry one UV set, so a material's textures must agree on theirs (TEXCOORD_0 or _1).
+void SceneBuilder::chooseMaterialTexCoord(const std::string& at, Material& out) {
   if (materialTexCoords_.size() == 1 && (*materialTexCoords_.begin() == 0 || *materialTexCoords_.begin() == 1)) {
     out.texCoord = *materialTexCoords_.begin();
   } else if (!materialTexCoords_.empty()) {
@@ -266,7 +293,6 @@ Material SceneBuilder::convertMaterial(int index) {
     warn(at + " '" + oneLine(out.name) + "': its textures read " + sets +
          "; caustica keeps one UV set per material (TEXCOORD_0 or TEXCOORD_1) and uses TEXCOORD_0 for all of them");
   }
-  return out;
 }
 
 int SceneBuilder::texture(const tinygltf::TextureInfo& info, const std::string& at) {
