@@ -193,6 +193,9 @@ class Renderer {
   std::vector<std::string> shaderDefines() const;
   // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
+  // Binds the scene's storage blocks, UBOs and textures as the compute shaders read them (before each
+  // dispatch; also for GPU tests that run a library function over the scene in their own entry shader).
+  void bindSceneForDispatch();
 
  private:
   const GlProgram& program();
@@ -205,7 +208,6 @@ class Renderer {
   gpu::CasterParams casterParams() const;  // the caster UBO for the current settings and cells
   // The caustic photon pass (caustic_cells.h), once per scene, before the first manifold NEE variant runs.
   void buildCausticCells();
-  void bindSceneForDispatch();  // the scene's storage blocks, UBOs and textures, as the compute shaders read them
   // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
   void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
