@@ -30,17 +30,11 @@ const char* casterName(const ManifoldTestScene& t, unsigned c) {
   return c == t.glass ? "glass sphere" : c == t.mirrorBall ? "mirror sphere" : "flat mirror";
 }
 
-// The largest of a measured error over many queries, printed on request.
-struct Worst {
-  std::string what;
-  double value = 0;
-  int count = 0;
-  void add(double v) {
-    ++count;
-    if (!(v <= value)) value = v;  // NaN sticks
-  }
+// A measured maximum, printed on request.
+struct Worst : WorstError {
+  using WorstError::WorstError;
   void report() const {
-    if (reportWanted()) MESSAGE(what, ": worst ", value, " over ", count);
+    if (reportWanted()) MESSAGE(text());
   }
 };
 

@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -19,6 +21,23 @@
 #include "../gpu/scene_builder.h"
 
 namespace caustica::test {
+
+// The largest of an error measured over many queries (a NaN sticks), and over how many.
+struct WorstError {
+  explicit WorstError(std::string w) : what(std::move(w)) {}
+  std::string what;
+  double value = 0;
+  int count = 0;
+  void add(double v) {
+    ++count;
+    if (!(v <= value)) value = v;
+  }
+  std::string text() const {
+    std::ostringstream s;
+    s << what << ": worst " << value << " over " << count;
+    return s.str();
+  }
+};
 
 struct ManifoldTestScene {
   Scene scene;

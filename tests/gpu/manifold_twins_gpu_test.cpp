@@ -83,17 +83,12 @@ class GlslManifold {
 
 bool reportWanted() { return std::getenv("CAUSTICA_TWINS_REPORT") != nullptr; }
 
-struct Worst {
-  std::string what;
-  double value = 0;
-  int count = 0;
-  void add(double v) {
-    ++count;
-    if (!(v <= value)) value = v;
-  }
+// A measured maximum against its tolerance.
+struct Worst : WorstError {
+  using WorstError::WorstError;
   void check(double tol) const {
-    if (reportWanted()) MESSAGE(what, ": worst ", value, " over ", count, " (tolerance ", tol, ")");
-    INFO(what, ": worst ", value, " over ", count);
+    if (reportWanted()) MESSAGE(text(), " (tolerance ", tol, ")");
+    INFO(text());
     CHECK(value <= tol);
   }
 };
