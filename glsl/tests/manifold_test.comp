@@ -37,6 +37,8 @@ const uint kTraceChain = 1u;    // traceManifoldChain at ab = seed
 const uint kTransferDiff = 2u;  // transferDiff(in0, in1, in2, in2.w, in3)
 const uint kRefractDiff = 3u;   // refractDiff(in0, in1, in1.w, ., in2, in3, ., in4, in5, .)
 const uint kReflectDiff = 4u;   // reflectDiff(in0, in1, in2, in3)
+const uint kNormalDiff = 5u;    // normalDiffOn at triangle in0.w (bits), barycentrics in0.xy, ns in1;
+                                // normalDerivative for dp in2
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -59,6 +61,24 @@ void main() {
   }
   if (function == kReflectDiff) {
     outRec[o] = vec4(reflectDiff(a[0].xyz, a[1].xyz, a[2].xyz, a[3].xyz), 0.0);
+    return;
+  }
+  if (function == kNormalDiff) {
+    Hit hit;
+    hit.t = 1.0;
+    hit.u = a[0].x;
+    hit.v = a[0].y;
+    hit.tri = floatBitsToUint(a[0].w);
+#ifdef CAUSTICA_INSTANCED
+    hit.inst = 0u;
+#endif
+    HitTriangle h = hitTriangle(hit);
+    NormalDiff nd = normalDiffOn(hit, h, a[1].xyz);
+    outRec[o] = vec4(nd.gu, nd.scale);
+    outRec[o + 1u] = vec4(nd.gv, 0.0);
+    outRec[o + 2u] = vec4(nd.dn1, 0.0);
+    outRec[o + 3u] = vec4(nd.dn2, 0.0);
+    outRec[o + 4u] = vec4(normalDerivative(nd, a[1].xyz, a[2].xyz), 0.0);
     return;
   }
   ManifoldQuery q;

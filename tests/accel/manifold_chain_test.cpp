@@ -244,7 +244,9 @@ TEST_CASE("manifold chain: the Jacobian, dA/domega and the throughput match fini
     // conditioned up to 100 near its caustic, and the glass chain's rounding, which grows as h shrinks), 4e-4,
     // 4e-5, its mean over ~250 points within 2e-4; the flat mirror's closed form 1.5e-6; throughput 2e-6.
     // A 0.5 % error of J, of dA/domega's mean or of a Fresnel factor fails.
-    CHECK(ok * 10 >= static_cast<int>(qs.size()) * 9);  // measured 271-290 of 300 (a seed on no chain gives up)
+    // Measured 290, 277 and 271 of 300: a seed whose own chain breaks (a tilted axis past the flat
+    // mirror's edge) gives up at once.
+    CHECK(ok * 20 >= static_cast<int>(qs.size()) * 17);
     CHECK(skipped * 3 <= ok * 2);                       // points where a difference crosses a triangle edge
     CHECK(areaCount >= 200);
     CHECK(jac.value <= 2e-3);
