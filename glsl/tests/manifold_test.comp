@@ -25,13 +25,13 @@ layout(local_size_x = 64) in;
 // Per record 7 vec4: (x, caster bits), (xOrg, lambda), (sigma, uLambda), (axis, 0), (y, 0), (nL, 0), (seed, 0, 0);
 // the differential functions read their arguments from the same words (see main).
 layout(std430, binding = 0) readonly buffer InBuffer { vec4 inRec[]; };
-// Per record 7 vec4 (see main).
+// Per record 8 vec4 (see main).
 layout(std430, binding = 1) writeonly buffer OutBuffer { vec4 outRec[]; };
 
 layout(location = 0) uniform uint recordCount;
 layout(location = 1) uniform uint function;
 
-const uint kInVec4 = 7u, kOutVec4 = 7u;
+const uint kInVec4 = 7u, kOutVec4 = 8u;
 const uint kSolve = 0u;         // manifoldSolve
 const uint kTraceChain = 1u;    // traceManifoldChain at ab = seed
 const uint kTransferDiff = 2u;  // transferDiff(in0, in1, in2, in2.w, in3)
@@ -93,7 +93,7 @@ void main() {
   q.nL = a[5].xyz;
   q.seed = a[6].xy;
   // Out: (ok or chain traced, converged, 0, 0), (w, areaPerSolidAngle), (throughput, eventProb), (ab, F),
-  // (J[0], J[1]), (pLast, 0), (dLast, 0).
+  // (J[0], J[1]), (pLast, 0), (dLast, 0), (filt, lambda).
   ManifoldResult r;
   if (function == kSolve) {
     r = manifoldSolve(q, true);
@@ -113,4 +113,5 @@ void main() {
   outRec[o + 2u] = vec4(r.throughput, r.eventProb);
   outRec[o + 5u] = vec4(r.pLast, 0.0);
   outRec[o + 6u] = vec4(r.dLast, 0.0);
+  outRec[o + 7u] = vec4(r.filt, r.lambda);
 }

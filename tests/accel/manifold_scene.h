@@ -63,13 +63,20 @@ struct ManifoldTestScene {
 };
 
 // Builds the scene; the BVH, GpuScene and 4-wide nodes as Renderer::buildScene makes them for a flat
-// scene, and the caster UBO as Renderer::casterParams fills it.
-inline ManifoldTestScene makeManifoldTestScene() {
+// scene, and the caster UBO as Renderer::casterParams fills it. dispersiveGlass: the glass disperses
+// (Abbe number 30) and absorbs (KHR_materials_volume), which the forward tracer below does not follow.
+inline ManifoldTestScene makeManifoldTestScene(bool dispersiveGlass = false) {
   ManifoldTestScene t;
   Scene& s = t.scene;
   t.floorMaterial = addMaterial(s, diffuseMaterial(0.5f));
   std::uint32_t lamp = addMaterial(s, emitterMaterial(20.0f));
-  std::uint32_t glass = addMaterial(s, glassMaterial(t.glassIor));
+  Material glassM = glassMaterial(t.glassIor);
+  if (dispersiveGlass) {
+    glassM.dispersion = 20.0f / 30.0f;
+    glassM.attenuationColor = glm::vec3(0.6f, 0.8f, 0.95f);
+    glassM.attenuationDistance = 0.3f;
+  }
+  std::uint32_t glass = addMaterial(s, glassM);
   std::uint32_t mirror = addMaterial(s, metalMaterial(t.mirrorColor));
   const float S = 2.0f, h = t.lampHalf, Y = t.lampCentre.y, X = t.mirrorX;
   addQuad(s, {-S, 0, -S}, {-S, 0, S}, {S, 0, S}, {S, 0, -S}, t.floorMaterial);  // faces +y
