@@ -94,7 +94,7 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
   // 4-cm lamp is all fireflies at these spp (measured relMSE 2.1 / 1.2 / 0.84 at 128 / 256 / 512 spp,
   // not falling as 1/spp; 8 seeds' single-run ratios -3.3 to 87), where no estimate from the image's
   // own samples can hold.
-  rs.manifold = name == "lamp-caustics";
+  rs.manifold = name == "lamp-caustics" ? ManifoldMode::On : ManifoldMode::Off;
   const Reference ref = renderReference(scene, camera, rs, referenceSpp);
   const Image& reference = ref.image;
   const double referenceNoise = ref.noise;

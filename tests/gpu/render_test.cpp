@@ -42,7 +42,7 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
     RenderSettings settings = smallSettings(w, h, integrator, seedBase + r);
     settings.maxDepth = maxDepth;
     settings.casterProbability = casterProbability;
-    settings.manifold = manifold;
+    settings.manifold = manifold ? ManifoldMode::On : ManifoldMode::Off;
     RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     if (defines) *defines = res.defines;
