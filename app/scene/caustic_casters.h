@@ -37,7 +37,7 @@ std::vector<CausticCaster> findCausticCasters(const Scene& scene, int maxCasters
 // caster rarely reaches them; under a large lamp caster aiming already finds the caustic and the
 // Newton solve only costs. A caster qualifies when it is smooth and the emitters' summed solid angle
 // seen from its centre is positive and below kManifoldAutoSolidAngle (steradians), chosen by measurement.
-constexpr float kManifoldAutoSolidAngle = 0.05f;
+constexpr float kManifoldAutoSolidAngle = 0.015f;
 bool manifoldAutoEligible(const CausticCaster& c);
 
 // Sets each caster's emitterSolidAngle (from the emissive triangles of `emitters`, each counted from
