@@ -170,7 +170,7 @@ class Renderer {
   Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
   // --background transparent in a mode that tracks coverage (the CAUSTICA_TRANSPARENT row): image()
   // has alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
-  bool hasAlpha() const { return variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_TRANSPARENT"); }
+  bool hasAlpha() const { return variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_)).has("CAUSTICA_TRANSPARENT"); }
   // Tone-maps the accumulation (with `denoised`, denoise()'s output) into the rgba8 display texture (viewer).
   const GlTexture& updateDisplay(const ToneMapSettings& tone, bool denoised = false);
   // Milliseconds the last denoise() took on the GPU (it waits for the GPU to finish); 0 before any.
@@ -238,7 +238,8 @@ class Renderer {
   ShadingTextures shadingTextures_;  // the shading's views of the materials, light-tree and texture buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
-  std::uint32_t cellTableMask_ = 0;  // CasterParams::count.z: the caustic cell table's bucket mask, once built
+  std::uint32_t cellTableMask_ = 0;
+  std::uint32_t cellCasters_ = 0;    // the casters (manifoldCasterMask) the cell table was built for  // CasterParams::count.z: the caustic cell table's bucket mask, once built
   CausticCells causticCells_;
   std::vector<LightGroup> lightGroups_;
   gpu::PointLights pointLights_{};
