@@ -26,7 +26,36 @@ layout(std430, binding = CAUSTICA_BINDING_CELL_KEYS) buffer CellKeys { uint keyW
 layout(std430, binding = CAUSTICA_BINDING_CELLS) buffer Cells { uint cellWords[]; };         // 4 per slot
 layout(std430, binding = CAUSTICA_BINDING_CELL_DROPS) buffer CellDrops { uint drops; };      // photons without a slot
 
-layout(location = 0) uniform uint photons;  // photons per caster (gl_GlobalInvocationID.x below it)
+// Per caster, `emitterEntries` entries (cumulative probability as float bits, light-tree leaf) in an order
+// that does not depend on the scene's scale or place (photonEmitterTable, caustic_cells.h).
+layout(std430, binding = CAUSTICA_BINDING_PHOTON_EMITTERS) readonly buffer PhotonEmitters { uvec2 photonEmitters[]; };
+
+layout(location = 0) uniform uint photons;         // photons per caster (gl_GlobalInvocationID.x below it)
+layout(location = 1) uniform uint emitterEntries;  // entries per caster of photonEmitters; 0: the light tree chooses
+
+// A point on the emitter photon `u` of caster `caster` leaves from: the first entry of the caster's
+// table whose cumulative probability exceeds u (binary search), else (no table) the light tree's choice
+// from the caster's centre.
+bool samplePhotonEmitter(uint caster, vec3 centre, float u, vec2 uTri, out LightSample ls) {
+  if (emitterEntries == 0u) return sampleLight(centre, vec3(0.0), u, uTri, ls);
+  if (frame.options.z == 0u) return false;
+  uint first = caster * emitterEntries, end = first + emitterEntries, len = emitterEntries;
+  while (len > 0u) {
+    uint step = len / 2u;
+    if (uintBitsToFloat(photonEmitters[first + step].x) <= u) {
+      first += step + 1u;
+      len -= step + 1u;
+    } else {
+      len = step;
+    }
+  }
+  if (first >= end) return false;
+  uvec4 link = lightNodeLink(photonEmitters[first].y);
+#ifdef CAUSTICA_INSTANCED
+  gLightInstance = link.y >> kLightNodeInstanceShift;
+#endif
+  return sampleLightTriangle(centre, link.x, 1.0, uTri, ls);
+}
 
 // Follows photon `index` of caster `caster` from an emitter through the caster's chain to a diffuse
 // surface: its landing point and the unit direction from there back to the chain's last vertex.
@@ -35,7 +64,7 @@ bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
   uvec4 rng = rngSeed(index, caster, 0x9e3779b9u);
   vec4 sphere = casters.sphere[caster];
   LightSample ls;
-  if (!sampleLight(sphere.xyz, vec3(0.0), rand01(rng), rand2(rng), ls)) return false;
+  if (!samplePhotonEmitter(caster, sphere.xyz, rand01(rng), rand2(rng), ls)) return false;
   vec3 axis;
   float omc;
   vec3 facing = ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n;

@@ -283,6 +283,7 @@ void packInstancedEmitters(const Scene& scene, const Scene& lights, const std::v
     totalWeight += w;
     lightItems.push_back(emitterItem(storedIndex[source[e].triangle], tri.p, w, m.doubleSided));
     lightItems.back().instance = source[e].instance;
+    lightItems.back().source = static_cast<std::uint32_t>(e);
   }
   g.emitterCount = lightItems.size();
   g.lightTree = buildLightTree(std::move(lightItems), g.triangleCount);
@@ -369,6 +370,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
     if (w == 0.0) continue;
     totalWeight += w;
     lightItems.push_back(emitterItem(static_cast<std::uint32_t>(i), tri.p, w, m.doubleSided));
+    lightItems.back().source = bvh.order[i];  // the scene's order: the BVH's can change with rounding
   }
   // The light tree the shaders choose emitters with; each emissive triangle finds its leaf through
   // TriGeom.v1.w (leaf index + 1 as uint bits, 0: not in the tree).

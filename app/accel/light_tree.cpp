@@ -90,6 +90,7 @@ struct Item {
   glm::dvec3 centroid;
   std::uint32_t tri;
   std::uint32_t instance;  // LightTreeItem::instance
+  std::uint32_t source;    // LightTreeItem::source
 };
 
 class Builder {
@@ -111,6 +112,7 @@ class Builder {
       node.link.z = trail;
       node.link.w = static_cast<std::uint32_t>(depth);
       tree_.leafOf[items[begin].tri] = nodeIndex;
+      leaves_.push_back({items[begin].source, nodeIndex});
       tree_.maxDepth = std::max(tree_.maxDepth, depth);
       return;
     }
@@ -181,6 +183,9 @@ class Builder {
   }
 
   LightTree& tree_;
+
+ public:
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> leaves_;  // (source, leaf node)
 };
 
 float cosSubClamped(float sinA, float cosA, float sinB, float cosB) {  // cos(max(0, a - b))
@@ -215,13 +220,19 @@ LightTree buildLightTree(std::vector<LightTreeItem> in, std::size_t triangleCoun
     it.centroid = (it.b.lo + it.b.hi) * 0.5;
     it.tri = t.tri;
     it.instance = t.instance;
+    it.source = t.source;
     if (t.instance >= (1u << (32 - gpu::kLightNodeInstanceShift)))
       throw Error("light_tree.cpp: more than 2^30 instances");
     items.push_back(it);
   }
   tree.nodes.reserve(2 * items.size());
   tree.nodes.resize(1);
-  Builder(tree).build(items, 0, items.size(), 0, 0, 0u);
+  Builder builder(tree);
+  builder.build(items, 0, items.size(), 0, 0, 0u);
+  std::stable_sort(builder.leaves_.begin(), builder.leaves_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  tree.leavesBySource.reserve(builder.leaves_.size());
+  for (const auto& l : builder.leaves_) tree.leavesBySource.push_back(l.second);
   return tree;
 }
 

@@ -18,12 +18,17 @@ struct LightTreeItem {
   double power = 0.0;     // luminance(emission) * area * sides (> 0)
   bool twoSided = false;  // emits from both faces
   std::uint32_t instance = 0;  // instanced scenes: Scene::instances index, kept in the leaf's link.y (< 2^30)
+  std::uint32_t source = 0;    // its place in an order that does not depend on the BVH (the scene's triangle
+                               // order): LightTree::leavesBySource follows it
 };
 
 struct LightTree {
   std::vector<gpu::LightNode> nodes;  // node 0 is the root; children adjacent; one triangle per leaf
   std::vector<std::uint32_t> leafOf;  // per triangle (TriGeom order): its leaf node, or kInvalidIndex
   int maxDepth = 0;                   // deepest leaf (root = 0); at most CAUSTICA_LIGHT_TREE_DEPTH
+  // Every leaf, in the order of its item's `source`: an order that scaling or moving the scene keeps
+  // (the tree's own order can change with rounding; the caustic photon pass, caustic_cells.h).
+  std::vector<std::uint32_t> leavesBySource;
 };
 
 // Builds the tree: binary splits in 12 buckets per axis minimising power x orientation measure x

@@ -2,6 +2,7 @@
 #include "gpu/caustic_cells.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
@@ -15,7 +16,40 @@ std::uint32_t cellTableBuckets(std::uint32_t casters) {
   return buckets;
 }
 
-bool CausticCells::run(const GlProgram& program, std::uint32_t casters, std::uint32_t buckets) {
+std::vector<glm::uvec2> photonEmitterTable(const LightTree& tree, const gpu::CasterParams& cp) {
+  const std::size_t n = tree.leavesBySource.size(), casters = cp.count.x;
+  if (n == 0 || casters == 0 || static_cast<std::uint64_t>(n) * casters > kMaxPhotonEmitterEntries) return {};
+  std::vector<glm::uvec2> table(n * casters, glm::uvec2(0u));
+  std::vector<double> cdf(n);
+  for (std::size_t c = 0; c < casters; ++c) {
+    if ((cp.count.w & (1u << c)) == 0u) continue;
+    const glm::dvec3 centre(cp.sphere[c]);
+    const double r = cp.sphere[c].w;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const gpu::LightNode& leaf = tree.nodes[tree.leavesBySource[k]];
+      const glm::dvec3 d = centre - 0.5 * (glm::dvec3(leaf.boundsMin) + glm::dvec3(leaf.boundsMax));
+      const double d2 = glm::dot(d, d), dist = std::sqrt(d2);
+      double cosW = dist > 0.0 ? glm::dot(glm::dvec3(leaf.axis), d) / dist : 1.0;
+      if ((leaf.link.y & gpu::kLightNodeTwoSided) != 0u) cosW = std::abs(cosW);
+      // The smallest emission angle towards the sphere: theta_w less the sphere's half angle.
+      const double beta = dist > r ? std::asin(r / dist) : 1.5707963267948966;
+      const double theta = std::max(0.0, std::acos(std::clamp(cosW, -1.0, 1.0)) - beta);
+      const double w = static_cast<double>(leaf.boundsMin.w) * std::max(0.0, std::cos(theta)) / std::max(d2, r * r);
+      sum += std::isfinite(w) ? w : 0.0;
+      cdf[k] = sum;
+    }
+    if (!(sum > 0.0)) continue;
+    for (std::size_t k = 0; k < n; ++k) {
+      const float p = k + 1 == n ? 1.0f : static_cast<float>(cdf[k] / sum);
+      table[c * n + k] = glm::uvec2(glm::floatBitsToUint(p), tree.leavesBySource[k]);
+    }
+  }
+  return table;
+}
+
+bool CausticCells::run(const GlProgram& program, std::uint32_t casters, std::uint32_t buckets, const GlBuffer& emitters,
+                       std::uint32_t entries) {
   keys_ = GlBuffer::fromVector(std::vector<std::uint32_t>(4u * buckets, 0u), GL_DYNAMIC_COPY);
   cells_ = GlBuffer::fromVector(std::vector<gpu::CausticCell>(4u * buckets, gpu::CausticCell{0u, 0u, 0u, 0u}), GL_DYNAMIC_COPY);
   const std::uint32_t zero = 0;
@@ -23,8 +57,10 @@ bool CausticCells::run(const GlProgram& program, std::uint32_t casters, std::uin
   keys_.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_CELL_KEYS);
   cells_.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_CELLS);
   drops.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_CELL_DROPS);
+  if (entries > 0) emitters.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_PHOTON_EMITTERS);
   program.use();
   glUniform1ui(0, kCausticPhotons);
+  glUniform1ui(1, entries);
   if (casters > 0) glDispatchCompute((kCausticPhotons + 63u) / 64u, casters, 1u);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
   std::uint32_t dropped = 0;

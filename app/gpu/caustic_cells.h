@@ -6,13 +6,31 @@
 // so a render and its resumed continuation see the same cells.
 #pragma once
 #include <cstdint>
+#include <vector>
 
+#include <glm/glm.hpp>
+
+#include "accel/light_tree.h"
 #include "gpu/gl_objects.h"
 #include "shared/gpu_layout.h"
 
 namespace caustica {
 
 constexpr std::uint32_t kCausticPhotons = 1u << 16;  // photons per caster
+
+// Most entries photonEmitterTable makes (32 MiB); beyond, the photon pass lets the light tree choose.
+constexpr std::uint64_t kMaxPhotonEmitterEntries = 1u << 22;
+
+// Where the photons of each caster of cp (cp.count.x of them) leave from: per caster, one entry per
+// light-tree leaf in tree.leavesBySource order, (cumulative probability as float bits, leaf index),
+// the probability of an emitter in proportion to power x bounded emission cosine towards the caster's
+// sphere / clamped squared distance to its centre (lightImportance's bound, per triangle). A continuous
+// function of the geometry in an order the scene's scale and place keep, so that a scaled or moved
+// scene sends its photons from the same points (the light tree's own choice from the caster's centre
+// follows its cones, which rounding can rebuild otherwise). Casters outside cp.count.w, or without an
+// emitter facing them, get all-zero entries (no photons). Empty (the light tree chooses) without
+// emitters or with more than kMaxPhotonEmitterEntries entries.
+std::vector<glm::uvec2> photonEmitterTable(const LightTree& tree, const gpu::CasterParams& cp);
 
 // Buckets (of 4 slots) of a first table for `casters` casters: a power of 2 with room for every
 // photon landing in a cell of its own at half load.
@@ -23,12 +41,16 @@ class CausticCells {
   // Runs the photon pass with `program` (caustic_photons.comp; the scene's textures, storage blocks and
   // UBOs bound as for a path-tracing dispatch) for the cp.count.x casters of `cp`, whose count.z it sets
   // to the table's bucket mask; `upload(cp)` puts cp where the shaders read it (called before each try).
+  // The photons leave from emitters drawn from `tree`'s photonEmitterTable.
   template <class Upload>
-  void build(const GlProgram& program, gpu::CasterParams& cp, Upload&& upload) {
+  void build(const GlProgram& program, const LightTree& tree, gpu::CasterParams& cp, Upload&& upload) {
+    const std::vector<glm::uvec2> emitters = photonEmitterTable(tree, cp);
+    const GlBuffer emitterBuffer = emitters.empty() ? GlBuffer() : GlBuffer::fromVector(emitters);
+    const auto entries = static_cast<std::uint32_t>(emitters.size() / std::max<std::uint32_t>(cp.count.x, 1u));
     for (std::uint32_t buckets = cellTableBuckets(cp.count.x), tries = 0; tries < 3; ++tries, buckets *= 2) {
       cp.count.z = buckets - 1u;
       upload(cp);
-      if (run(program, cp.count.x, buckets)) return;
+      if (run(program, cp.count.x, buckets, emitterBuffer, entries)) return;
     }
     cp.count.z = 0u;  // no table: manifold NEE finds no cells (the same on every run)
     upload(cp);
@@ -38,7 +60,9 @@ class CausticCells {
   std::size_t bytes() const { return keys_.size() + cells_.size(); }
 
  private:
-  bool run(const GlProgram& program, std::uint32_t casters, std::uint32_t buckets);  // false: a photon was dropped
+  // false: a photon was dropped. `emitters`: photonEmitterTable's, `entries` per caster (0: none).
+  bool run(const GlProgram& program, std::uint32_t casters, std::uint32_t buckets, const GlBuffer& emitters,
+           std::uint32_t entries);
   GlBuffer keys_, cells_;
   GlBufferTexture keysView_, cellsView_;
   bool built_ = false;

@@ -358,7 +358,7 @@ void Renderer::buildCausticCells() {
   bindSceneForDispatch();
   gpu::CasterParams cp = casterParams();
   cellCasters_ = cp.count.w;
-  causticCells_.build(photons, cp, [&](const gpu::CasterParams& built) {
+  causticCells_.build(photons, gpuScene_.lightTree, cp, [&](const gpu::CasterParams& built) {
     cellTableMask_ = built.count.z;
     uploadCasters();
   });

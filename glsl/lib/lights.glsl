@@ -36,13 +36,9 @@ float instanceLightPdfArea(TriGeom g, InstanceXform x, vec3 p, vec3 n) {
 }
 #endif
 
-// Samples a point on an emitter for shading point p with unit normal n (world space): uSelect descends
-// the light tree, uTri places the point uniformly on the chosen triangle.
-bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
-  if (frame.options.z == 0u) return false;
-  uint tri;
-  float pmf;
-  if (!sampleLightTree(p, n, uSelect, tri, pmf)) return false;
+// A uniform point (uTri) on emissive triangle `tri` (TriGeom order; instanced: of instance
+// gLightInstance), chosen with probability pmf, as seen from p.
+bool sampleLightTriangle(vec3 p, uint tri, float pmf, vec2 uTri, out LightSample ls) {
 #ifdef CAUSTICA_INSTANCED
   InstanceXform xf = instanceXform(gLightInstance);  // the leaf's instance: its world-space triangle
   TriGeom g = instanceTriangle(tri, xf);
@@ -90,4 +86,14 @@ bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
   ls.pdfArea = pmf / (0.5 * len);
   ls.twoSided = (m.tex.z & kMatDoubleSided) != 0u;
   return ls.pdfArea > 0.0;
+}
+
+// Samples a point on an emitter for shading point p with unit normal n (world space): uSelect descends
+// the light tree, uTri places the point uniformly on the chosen triangle.
+bool sampleLight(vec3 p, vec3 n, float uSelect, vec2 uTri, out LightSample ls) {
+  if (frame.options.z == 0u) return false;
+  uint tri;
+  float pmf;
+  if (!sampleLightTree(p, n, uSelect, tri, pmf)) return false;
+  return sampleLightTriangle(p, tri, pmf, uTri, ls);
 }

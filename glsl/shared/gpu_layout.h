@@ -51,6 +51,7 @@ using uint = std::uint32_t;
 #define CAUSTICA_BINDING_CELL_KEYS 0    // caustic_photons.comp only: SSBO of the cell table's keys (atomic compare-and-swap)
 #define CAUSTICA_BINDING_CELLS 1        // caustic_photons.comp only: SSBO of CausticCell words (atomic adds)
 #define CAUSTICA_BINDING_CELL_DROPS 2   // caustic_photons.comp only: SSBO: photons whose cell found no free slot
+#define CAUSTICA_BINDING_PHOTON_EMITTERS 3  // caustic_photons.comp only: SSBO of uvec2 per caster and emitter (photonEmitterTable)
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
 #define CAUSTICA_BINDING_PUNCTUAL 4   // UBO: PunctualParams (KHR_lights_punctual; a UBO, not a ninth SSBO)
