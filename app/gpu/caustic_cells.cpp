@@ -69,17 +69,24 @@ bool CausticCells::run(const GlProgram& program, std::uint32_t casters, std::uin
   cellsView_ = GlBufferTexture::create(cells_, GL_RGBA32UI);
   built_ = true;
   if (std::getenv("CAUSTICA_CELLS_DEBUG")) {
-    std::vector<gpu::CausticCell> got(4u * buckets);
-    cells_.read(0, got.size() * sizeof(gpu::CausticCell), got.data());
-    std::uint64_t photons = 0, used = 0;
-    for (const auto& c : got) {
-      photons += c.count;
-      used += c.count > 0;
-    }
-    std::fprintf(stderr, "cells: %u buckets, %llu cells used, %llu photons, %u dropped\n", buckets,
-                 (unsigned long long)used, (unsigned long long)photons, dropped);
+    const CausticCellStats s = stats();
+    std::fprintf(stderr, "cells: %u buckets, %llu cells used, %llu photons, %u dropped\n", s.buckets,
+                 (unsigned long long)s.cells, (unsigned long long)s.photons, dropped);
   }
   return dropped == 0;
+}
+
+CausticCellStats CausticCells::stats() const {
+  CausticCellStats s;
+  if (!built_) return s;
+  std::vector<gpu::CausticCell> got(cells_.size() / sizeof(gpu::CausticCell));
+  cells_.read(0, got.size() * sizeof(gpu::CausticCell), got.data());
+  for (const auto& c : got) {
+    s.photons += c.count;
+    s.cells += c.count > 0;
+  }
+  s.buckets = static_cast<std::uint32_t>(got.size() / 4u);
+  return s;
 }
 
 void CausticCells::bind() const {

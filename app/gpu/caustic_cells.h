@@ -36,6 +36,12 @@ std::vector<glm::uvec2> photonEmitterTable(const LightTree& tree, const gpu::Cas
 // photon landing in a cell of its own at half load.
 std::uint32_t cellTableBuckets(std::uint32_t casters);
 
+// What a built table holds: the photons that landed in a cell and the cells they filled.
+struct CausticCellStats {
+  std::uint64_t photons = 0, cells = 0;
+  std::uint32_t buckets = 0;  // the table's size (4 slots each)
+};
+
 class CausticCells {
  public:
   // Runs the photon pass with `program` (caustic_photons.comp; the scene's textures, storage blocks and
@@ -58,6 +64,7 @@ class CausticCells {
   void bind() const;  // on CAUSTICA_TEXUNIT_CELL_KEYS and CAUSTICA_TEXUNIT_CELLS
   bool built() const { return built_; }
   std::size_t bytes() const { return keys_.size() + cells_.size(); }
+  CausticCellStats stats() const;  // reads the table back (zero before a build)
 
  private:
   // false: a photon was dropped. `emitters`: photonEmitterTable's, `entries` per caster (0: none).

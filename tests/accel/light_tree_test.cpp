@@ -73,6 +73,20 @@ TEST_CASE("light tree: one leaf per emitter, children adjacent, leafOf maps back
   CHECK(buildLightTree({}, 3).nodes.empty());
 }
 
+TEST_CASE("light tree: leavesBySource lists every leaf in its item's source order") {
+  auto items = randomLights(300, 2);
+  for (std::size_t i = 0; i < items.size(); ++i) items[i].source = static_cast<std::uint32_t>((i * 7919u) % 300u);
+  LightTree t = buildLightTree(items, 601);
+  REQUIRE(t.leavesBySource.size() == items.size());
+  std::vector<std::uint32_t> triOfSource(300);
+  for (const auto& it : items) triOfSource[it.source] = it.tri;
+  for (std::uint32_t s = 0; s < 300; ++s) {
+    const gpu::LightNode& leaf = t.nodes[t.leavesBySource[s]];
+    REQUIRE((leaf.link.y & gpu::kLightNodeLeaf) != 0u);
+    CHECK(leaf.link.x == triOfSource[s]);
+  }
+}
+
 // The sum is 1 minus the mass of dead ends (deadEndMass), which is reported; the chi-square test below
 // shows the sampler draws each triangle with the probability lightTreePdf gives.
 TEST_CASE("light tree: the probabilities of all triangles sum to 1 at random points") {
