@@ -95,6 +95,14 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
     const bool unlit = !sceneHasLights(original);
     if (unlit) original.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
     RenderSettings settings = smallSettings(48, 48, Integrator::Mis, 3);
+    // With the default --manifold auto (manifold NEE on mirror-caustic), except on lamp-caustics: its
+    // caustic photon pass is the same at every transform (the test below), but its light tree is not at
+    // x100 and x1e4 (the cones of its few-centimetre lamp's triangles, whose normals the scaled vertices
+    // round 1e-5 apart, are grown in another order), so next-event estimation draws other light samples
+    // there; manifold NEE solves from those samples, and the two renders are independent estimates of
+    // its caustic (measured at 16 spp: image mean 0.7 % and caustic region 3.6 % apart), not this test's
+    // same-path comparison. Without manifold NEE the same light samples differ too, within tolerance.
+    if (name == "lamp-caustics") settings.manifold = ManifoldMode::Off;
     RenderResult ref = renderScene(original, sceneCamera(original), settings, spp, spp);
     const double refMean = meanOf(ref.image);
     std::vector<PixelRect> regions = {{0, 0, 24, 24}, {24, 0, 48, 24}, {0, 24, 24, 48}, {24, 24, 48, 48}};
