@@ -491,8 +491,8 @@ struct ManifoldView {
   Camera camera;
   int sppNaive, sppMis, sppManifold;  // per render; 0: leave naive out (a lamp it finds too rarely)
   // Whether this view's mean against mis must resolve a 0.5 % bias (asserted: kManifoldSigmas standard
-  // errors of the difference <= 0.5 % of the mean): in the normal run, or only with CAUSTICA_LONG_TESTS.
-  bool sharp = false, sharpLong = false;
+  // errors of the difference <= 0.5 % of the mean).
+  bool sharp = false;
 };
 
 // Manifold NEE against mis without it and against naive over a view and its four quadrants: each
@@ -534,7 +534,7 @@ void checkManifoldUnbiased(const std::string& what, const Scene& scene, const Ma
       if (q == 0) {
         MESSAGE(what, ", ", view.name, ", manifold ", mm, " against ", name, " ", mo, ": difference ",
                 100.0 * (mm - mo) / mo, " % (", (mm - mo) / se, " standard errors); resolves a bias of ", resolves, " %");
-        if (name == "mis" && (view.sharp || (view.sharpLong && longTests()))) CHECK(resolves <= 0.5);
+        if (name == "mis" && view.sharp) CHECK(resolves <= 0.5);
       }
     }
     MESSAGE(what, ", ", view.name, " quadrants against ", name, ": resolve a bias of ", worstQuadrant, " % or less");
@@ -566,15 +566,15 @@ ManifoldView causticRegion(const Scene& scene, double x0, double y0, double x1, 
 // the light that manifold NEE joins through the ball.
 TEST_CASE("manifold NEE is unbiased: glass ball focus") {
   Scene scene = causticScene(0.0f, 0.3f);
-  ManifoldView focus{"caustic region (focus)", causticFocusCamera(scene, 0.01), 2048, 8192, 1536, true, true};
+  ManifoldView focus{"caustic region (focus)", causticFocusCamera(scene, 0.01), 2048, 8192, 1536, true};
   checkManifoldUnbiased("glass ball, 60 cm lamp", scene, focus);
 }
 
 TEST_CASE("manifold NEE is unbiased: mirror-caustic") {
   Scene scene = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
-  checkManifoldUnbiased("mirror-caustic", scene, {"image", sceneCamera(scene), 2048, 32768, 1408, true, true});
+  checkManifoldUnbiased("mirror-caustic", scene, {"image", sceneCamera(scene), 2048, 32768, 1408, true});
   ManifoldView region = causticRegion(scene, 0.30, 0.50, 0.70, 0.85, 2048, 24576, 1280);
-  region.sharp = region.sharpLong = true;
+  region.sharp = true;
   checkManifoldUnbiased("mirror-caustic", scene, region);
 }
 
