@@ -82,7 +82,9 @@ bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
 
 void main() {
   uint index = gl_GlobalInvocationID.x, caster = gl_GlobalInvocationID.y;
-  if (index >= photons || caster >= casters.count.x) return;
+  // Casters outside count.w (--manifold auto's choice) get no photons: no cells, so manifold NEE
+  // never joins through them and a bounce through them keeps weight 1 (path_manifold.glsl).
+  if (index >= photons || caster >= casters.count.x || (casters.count.w & (1u << caster)) == 0u) return;
   vec3 landing, back;
   if (!tracePhoton(caster, index, landing, back)) return;
   uint key = casterCellKey(caster, landing);

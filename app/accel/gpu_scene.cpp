@@ -248,6 +248,7 @@ Scene flattenCastersAndLights(const Scene& scene, GpuScene& g, std::vector<Insta
                 " of an instanced scene (load it with --instances off)");
   Scene lights = flattenedSubset(scene, emissive, &source);
   g.emitterSphere = emitterBoundingSphere(lights);
+  rateCastersForManifold(g.casters, lights);
   return lights;
 }
 
@@ -350,6 +351,7 @@ GpuScene packScene(const Scene& scene, const Bvh& bvh, bool triangleArrays) {
   GpuScene g;
   g.casters = findCausticCasters(scene, CAUSTICA_MAX_CASTERS);
   g.emitterSphere = emitterBoundingSphere(scene);
+  rateCastersForManifold(g.casters, scene);
   packEnvironment(scene, g);
   g.nodes = bvh.nodes;
   g.triangleCount = bvh.order.size();

@@ -75,97 +75,120 @@ unsigned casterOwning(const gpu::CasterParams& casters, const glm::vec3& p) {
   return owner;
 }
 
+RayDiff chainStartRay(const ManifoldQuery& q, const glm::vec2& ab, float& wLen) {
+  glm::vec3 t, b;
+  orthonormalBasis(q.axis, t, b);
+  glm::vec3 wRaw = q.axis + ab.x * t + ab.y * b;
+  wLen = glm::length(wRaw);
+  RayDiff r;
+  r.o = q.x;
+  r.d = wRaw / wLen;
+  r.oA = glm::vec3(0.0f);
+  r.oB = glm::vec3(0.0f);
+  r.dA = (t - r.d * glm::dot(r.d, t)) / wLen;
+  r.dB = (b - r.d * glm::dot(r.d, b)) / wLen;
+  return r;
+}
+
+bool chainEvent(const ManifoldScene& s, const ManifoldQuery& q, bool refractive, RayDiff& r, glm::vec3& org,
+                glm::vec3& sigma, ManifoldResult& res) {
+  Hit hit = traceClosest(*s.nodes, s.scene->triGeom, Ray{org, r.d}, 3.0e38f);
+  if (!hit.found()) return false;
+  ChainSurface sf;
+  if (!chainSurface(s, hit, r.d, sf) || casterOwning(s.casters, sf.p) != q.caster) return false;
+  res.throughput *= glm::exp(-sigma * hit.t);
+  glm::vec3 pA = transferDiff(r.oA, r.dA, r.d, hit.t, sf.ng);
+  glm::vec3 pB = transferDiff(r.oB, r.dB, r.d, hit.t, sf.ng);
+  glm::vec3 nA = normalDerivative(sf.nd, sf.ns, pA);
+  glm::vec3 nB = normalDerivative(sf.nd, sf.ns, pB);
+  float metal = sf.m.params.x, rough = sf.m.params.y;
+  glm::vec3 color = glm::vec3(sf.m.baseColor);
+  bool isSmooth = rough * rough < kDeltaAlpha;
+  glm::vec3 dNew, dA, dB;
+  if (refractive) {
+    float weight = (1.0f - metal) * sf.m.params.z;
+    float ior = sf.m.params.w;
+    if ((sf.m.tex.z & gpu::kMatDispersive) != 0u) {
+      if (res.lambda == 0.0f) pickWavelength(q.uLambda, s.spectral, res.lambda, res.filt);
+      ior = cauchyIor(ior, sf.m.absorption.w, res.lambda);
+    }
+    float eta = sf.front ? ior : 1.0f / ior;
+    if (!(weight > 0.0f) || !(isSmooth || ior == 1.0f) ||
+        !refractDiff(r.d, sf.ns, 1.0f / eta, dNew, r.dA, nA, dA, r.dB, nB, dB) || glm::dot(dNew, sf.ng) >= 0.0f)
+      return false;
+    float fresnel = fresnelDielectric(-glm::dot(r.d, sf.ns), eta);
+    res.eventProb *= weight * (1.0f - fresnel);
+    res.throughput *= color * (weight * (1.0f - fresnel) / (eta * eta));
+    sigma = sf.front && (sf.m.tex.z & gpu::kMatHasVolume) != 0u ? xyz(sf.m.absorption) : glm::vec3(0.0f);
+    org = offsetRayOrigin(sf.p, sf.pError, -sf.ng);
+    res.ngLast = -sf.ng;
+  } else {
+    float weight = metal;
+    dNew = glm::reflect(r.d, sf.ns);
+    if (!(weight > 0.0f) || !isSmooth || glm::dot(dNew, sf.ng) <= 0.0f) return false;
+    dA = reflectDiff(r.d, sf.ns, r.dA, nA);
+    dB = reflectDiff(r.d, sf.ns, r.dB, nB);
+    res.eventProb *= weight;
+    res.throughput *= color * weight;
+    org = offsetRayOrigin(sf.p, sf.pError, sf.ng);
+    res.ngLast = sf.ng;
+  }
+  r.o = sf.p;
+  r.oA = pA;
+  r.oB = pB;
+  r.d = dNew;
+  r.dA = dA;
+  r.dB = dB;
+  res.pLast = sf.p;
+  res.pLastError = sf.pError;
+  return true;
+}
+
+bool chainResidual(const ManifoldScene& s, const ManifoldQuery& q, const RayDiff& r, float wLen, ManifoldResult& res,
+                   glm::vec2& F, glm::mat2& J, bool& converged) {
+  converged = false;
+  F = glm::vec2(0.0f);
+  J = glm::mat2(1.0f);
+  glm::vec3 e = r.o - q.y;
+  glm::vec3 nP = glm::normalize(xyz(s.casters.sphere[q.caster]) - q.y);
+  float dn = glm::dot(r.d, nP);
+  if (!(dn < 0.0f)) return false;
+  float tL = -glm::dot(e, nP) / dn;
+  if (!(tL > 0.0f)) return false;
+  glm::vec3 uL, vL;
+  orthonormalBasis(nP, uL, vL);
+  glm::vec3 diff = e + tL * r.d;
+  glm::vec3 qA = transferDiff(r.oA, r.dA, r.d, tL, nP);
+  glm::vec3 qB = transferDiff(r.oB, r.dB, r.d, tL, nP);
+  F = glm::vec2(glm::dot(diff, uL), glm::dot(diff, vL));
+  J = glm::mat2(glm::dot(qA, uL), glm::dot(qA, vL), glm::dot(qB, uL), glm::dot(qB, vL));
+  res.dLast = r.d;
+  // dA on the light's triangle (normal nL) per solid angle at x: dA on the plane per d(ab), projected
+  // along d from the plane onto the triangle's, times d(ab)/d(omega) = |w|^3 (gnomonic).
+  float detJ = std::abs(J[0][0] * J[1][1] - J[1][0] * J[0][1]);
+  res.areaPerSolidAngle = detJ * wLen * wLen * wLen * std::abs(dn) / std::abs(glm::dot(r.d, q.nL));
+  static float tol = std::getenv("MTOL") ? float(atof(std::getenv("MTOL"))) : kManifoldTolerance;
+  converged = glm::length(diff) <= tol * glm::length(e);
+  return true;
+}
+
 bool traceManifoldChain(const ManifoldScene& s, const ManifoldQuery& q, const glm::vec2& ab, ManifoldResult& res,
                         glm::vec2& F, glm::mat2& J, bool& converged) {
   converged = false;
   F = glm::vec2(0.0f);
   J = glm::mat2(1.0f);
-  glm::vec3 t, b;
-  orthonormalBasis(q.axis, t, b);
-  glm::vec3 wRaw = q.axis + ab.x * t + ab.y * b;
-  float wLen = glm::length(wRaw);
-  glm::vec3 o = q.x, d = wRaw / wLen, oA(0.0f), oB(0.0f);
-  glm::vec3 dA = (t - d * glm::dot(d, t)) / wLen, dB = (b - d * glm::dot(d, b)) / wLen;
-  res.w = d;
+  float wLen;
+  RayDiff r = chainStartRay(q, ab, wLen);
+  res.w = r.d;
   res.ab = ab;
   res.throughput = glm::vec3(1.0f);
   res.eventProb = 1.0f;
   bool refractive = (s.casters.count.y & (1u << q.caster)) != 0u;
   unsigned events = refractive ? 2u : 1u;
   glm::vec3 org = q.xOrg, sigma = q.sigma;
-  for (unsigned k = 0; k < events; ++k) {
-    Hit hit = traceClosest(*s.nodes, s.scene->triGeom, Ray{org, d}, 3.0e38f);
-    if (!hit.found()) return false;
-    ChainSurface sf;
-    if (!chainSurface(s, hit, d, sf) || casterOwning(s.casters, sf.p) != q.caster) return false;
-    res.throughput *= glm::exp(-sigma * hit.t);
-    glm::vec3 pA = transferDiff(oA, dA, d, hit.t, sf.ng);
-    glm::vec3 pB = transferDiff(oB, dB, d, hit.t, sf.ng);
-    glm::vec3 nA = normalDerivative(sf.nd, sf.ns, pA);
-    glm::vec3 nB = normalDerivative(sf.nd, sf.ns, pB);
-    float metal = sf.m.params.x, rough = sf.m.params.y;
-    glm::vec3 color = glm::vec3(sf.m.baseColor);
-    bool isSmooth = rough * rough < kDeltaAlpha;
-    glm::vec3 dNew, dANew, dBNew;
-    if (refractive) {
-      float weight = (1.0f - metal) * sf.m.params.z;
-      float ior = sf.m.params.w;
-      if ((sf.m.tex.z & gpu::kMatDispersive) != 0u) {
-        if (res.lambda == 0.0f) pickWavelength(q.uLambda, s.spectral, res.lambda, res.filt);
-        ior = cauchyIor(ior, sf.m.absorption.w, res.lambda);
-      }
-      float eta = sf.front ? ior : 1.0f / ior;
-      if (!(weight > 0.0f) || !(isSmooth || ior == 1.0f) ||
-          !refractDiff(d, sf.ns, 1.0f / eta, dNew, dA, nA, dANew, dB, nB, dBNew) || glm::dot(dNew, sf.ng) >= 0.0f)
-        return false;
-      float fresnel = fresnelDielectric(-glm::dot(d, sf.ns), eta);
-      res.eventProb *= weight * (1.0f - fresnel);
-      res.throughput *= color * (weight * (1.0f - fresnel) / (eta * eta));
-      sigma = sf.front && (sf.m.tex.z & gpu::kMatHasVolume) != 0u ? xyz(sf.m.absorption) : glm::vec3(0.0f);
-      org = offsetRayOrigin(sf.p, sf.pError, -sf.ng);
-      res.ngLast = -sf.ng;
-    } else {
-      float weight = metal;
-      dNew = glm::reflect(d, sf.ns);
-      if (!(weight > 0.0f) || !isSmooth || glm::dot(dNew, sf.ng) <= 0.0f) return false;
-      dANew = reflectDiff(d, sf.ns, dA, nA);
-      dBNew = reflectDiff(d, sf.ns, dB, nB);
-      res.eventProb *= weight;
-      res.throughput *= color * weight;
-      org = offsetRayOrigin(sf.p, sf.pError, sf.ng);
-      res.ngLast = sf.ng;
-    }
-    o = sf.p;
-    oA = pA;
-    oB = pB;
-    d = dNew;
-    dA = dANew;
-    dB = dBNew;
-    res.pLast = sf.p;
-    res.pLastError = sf.pError;
-  }
-  // The exit ray on the plane through y facing the caster (normal nP): F = its point minus y.
-  glm::vec3 e = o - q.y;
-  glm::vec3 nP = glm::normalize(xyz(s.casters.sphere[q.caster]) - q.y);
-  float dn = glm::dot(d, nP);
-  if (!(dn < 0.0f)) return false;
-  float tL = -glm::dot(e, nP) / dn;
-  if (!(tL > 0.0f)) return false;
-  glm::vec3 uL, vL;
-  orthonormalBasis(nP, uL, vL);
-  glm::vec3 diff = e + tL * d;
-  glm::vec3 qA = transferDiff(oA, dA, d, tL, nP);
-  glm::vec3 qB = transferDiff(oB, dB, d, tL, nP);
-  F = glm::vec2(glm::dot(diff, uL), glm::dot(diff, vL));
-  J = glm::mat2(glm::dot(qA, uL), glm::dot(qA, vL), glm::dot(qB, uL), glm::dot(qB, vL));
-  res.dLast = d;
-  // dA on the light's triangle (normal nL) per solid angle at x: dA on the plane per d(ab), projected
-  // along d from the plane onto the triangle's, times d(ab)/d(omega) = |w|^3 (gnomonic).
-  float detJ = std::abs(J[0][0] * J[1][1] - J[1][0] * J[0][1]);
-  res.areaPerSolidAngle = detJ * wLen * wLen * wLen * std::abs(dn) / std::abs(glm::dot(d, q.nL));
-  static float tol = std::getenv("MTOL") ? float(atof(std::getenv("MTOL"))) : kManifoldTolerance;
-  converged = glm::length(diff) <= tol * glm::length(e);
-  return true;
+  bool ok = true;
+  for (unsigned k = 0; k < events && ok; ++k) ok = chainEvent(s, q, refractive, r, org, sigma, res);
+  return ok && chainResidual(s, q, r, wLen, res, F, J, converged);
 }
 
 ManifoldResult manifoldSolve(const ManifoldScene& s, const ManifoldQuery& q) {

@@ -46,6 +46,20 @@ struct ManifoldResult {
 
 // The first caster whose sphere holds p (manifold.glsl), else CAUSTICA_MAX_CASTERS.
 unsigned casterOwning(const gpu::CasterParams& casters, const glm::vec3& p);
+// A ray leaving a chain vertex and its derivatives with respect to the direction parameters ab.
+struct RayDiff {
+  glm::vec3 o{0.0f}, d{0.0f};    // origin (on the last surface, not offset) and unit direction
+  glm::vec3 oA{0.0f}, dA{0.0f};  // d(o)/da, d(d)/da
+  glm::vec3 oB{0.0f}, dB{0.0f};  // d(o)/db, d(d)/db
+};
+// The named steps of traceManifoldChain, as in manifold.glsl: the ray leaving x at ab (wLen: the
+// unnormalised direction's length); one specular event through the caster (r, org, sigma move past
+// it); the exit ray's residual on the plane through y, its Jacobian and area per solid angle.
+RayDiff chainStartRay(const ManifoldQuery& q, const glm::vec2& ab, float& wLen);
+bool chainEvent(const ManifoldScene& s, const ManifoldQuery& q, bool refractive, RayDiff& r, glm::vec3& org,
+                glm::vec3& sigma, ManifoldResult& res);
+bool chainResidual(const ManifoldScene& s, const ManifoldQuery& q, const RayDiff& r, float wLen, ManifoldResult& res,
+                   glm::vec2& F, glm::mat2& J, bool& converged);
 // One trace of the chain at direction parameters ab: false when the chain breaks; else the residual F
 // on the light's plane, its Jacobian J (column-major, J[c][r] = dF_r / d(ab)_c) and whether it converged.
 bool traceManifoldChain(const ManifoldScene& s, const ManifoldQuery& q, const glm::vec2& ab, ManifoldResult& res,

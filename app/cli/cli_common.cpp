@@ -122,9 +122,10 @@ std::vector<OptionSpec> sceneOptionSpecs() {
       {"--max-depth", "", "N", "maximum path length in bounces, a safety cap: Russian roulette ends paths (default 256)"},
       {"--caster-probability", "", "P",
        "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
-      {"--manifold", "", "on|off",
+      {"--manifold", "", "auto|on|off",
        "mis: manifold next-event estimation, light joined to diffuse points through glass and mirror objects "
-       "(caustics of small lights; default off)"},
+       "(caustics of small lights); auto (default) uses it through the objects the lights look small from "
+       "(caustica info lists them), on through all"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
       {"--light-radius", "", "R",
        "turn point and spot lights into emissive spheres of radius R (scene units), same power: bounces find "

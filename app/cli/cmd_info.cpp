@@ -151,9 +151,10 @@ void printFeatures(const Scene& s, const GpuScene& g) {
   std::printf("features:   %s\n", features.describe().c_str());
   if (g.casters.empty()) std::printf("casters:    none (no glass or mirror object)\n");
   for (size_t i = 0; i < g.casters.size(); ++i)
-    std::printf("%s %s sphere at %s, radius %.3g\n", i == 0 ? "casters:   " : "           ",
-                g.casters[i].refractive ? "glass " : "mirror", vec(glm::vec3(g.casters[i].sphere)).c_str(),
-                g.casters[i].sphere.w);
+    std::printf("%s %s sphere at %s, radius %.3g; emitters subtend %.3g sr: manifold auto %s\n",
+                i == 0 ? "casters:   " : "           ", g.casters[i].refractive ? "glass " : "mirror",
+                vec(glm::vec3(g.casters[i].sphere)).c_str(), g.casters[i].sphere.w, g.casters[i].emitterSolidAngle,
+                g.casters[i].manifoldAuto ? "on" : !g.casters[i].smooth ? "off (rough)" : "off");
   std::string defines;
   for (const auto& d : features.defines()) defines += " " + d;
   for (const auto& d : g.instanceDefines()) defines += " " + d;  // the two-level traversal, as the renderer adds it

@@ -36,9 +36,7 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
     m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
     throw Error(m.str());
   }
-  const std::string manifold = opts.get("--manifold", settingText(defaults.manifold));
-  if (manifold != "on" && manifold != "off") throw Error("option --manifold needs on or off (got '" + manifold + "')");
-  s.manifold = manifold == "on";
+  s.manifold = parseManifoldMode(opts.get("--manifold", settingText(defaults.manifold)));
   s.allFeatures = opts.has("--all-features");
   s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
   s.validate();

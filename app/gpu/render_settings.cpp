@@ -21,8 +21,18 @@ DispersionMode parseDispersionMode(const std::string& name) {
   throw Error("unknown dispersion mode '" + name + "' (expected rgb or spectral)");
 }
 
+ManifoldMode parseManifoldMode(const std::string& name) {
+  if (name == "auto") return ManifoldMode::Auto;
+  if (name == "on") return ManifoldMode::On;
+  if (name == "off") return ManifoldMode::Off;
+  throw Error("option --manifold needs auto, on or off (got '" + name + "')");
+}
+
 const char* integratorName(Integrator i) { return i == Integrator::Naive ? "naive" : "mis"; }
 const char* dispersionModeName(DispersionMode d) { return d == DispersionMode::Rgb ? "rgb" : "spectral"; }
+const char* manifoldModeName(ManifoldMode m) {
+  return m == ManifoldMode::Auto ? "auto" : m == ManifoldMode::On ? "on" : "off";
+}
 
 void RenderSettings::validate() const {
   if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
@@ -67,6 +77,7 @@ std::string settingText(bool v) { return v ? "on" : "off"; }
 std::string settingText(const std::string& v) { return v; }
 std::string settingText(Integrator v) { return integratorName(v); }
 std::string settingText(DispersionMode v) { return dispersionModeName(v); }
+std::string settingText(ManifoldMode v) { return manifoldModeName(v); }
 std::string settingText(RenderMode v) { return renderModeName(v); }
 
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to) {

@@ -13,10 +13,15 @@ namespace caustica {
 
 enum class Integrator { Naive, Mis };
 enum class DispersionMode { Rgb, Spectral };
+// Manifold NEE: Auto joins light only through the casters where it pays (manifoldAutoEligible,
+// scene/caustic_casters.h), On through every caster, Off never.
+enum class ManifoldMode { Auto, On, Off };
 Integrator parseIntegrator(const std::string& name);          // "naive" | "mis"; throws Error otherwise
 DispersionMode parseDispersionMode(const std::string& name);  // "rgb" | "spectral"; throws Error otherwise
+ManifoldMode parseManifoldMode(const std::string& name);      // "auto" | "on" | "off"; throws Error otherwise
 const char* integratorName(Integrator i);
 const char* dispersionModeName(DispersionMode d);
+const char* manifoldModeName(ManifoldMode m);
 
 constexpr int kMinMaxDepth = 1;                   // bounds of RenderSettings::maxDepth (path segments)
 constexpr int kMaxMaxDepth = 1024;
@@ -38,8 +43,9 @@ struct RenderSettings {
   float casterProbability = 0.5f;
   // mis only: manifold next-event estimation, which joins the light sample at a path's first diffuse
   // vertex to it through a glass or mirror caster (docs/path-tracer.md); scenes without casters or
-  // emitters never use it. Off by default until it measures faster (docs/path-tracer.md).
-  bool manifold = false;
+  // emitters never use it. Auto (the default) uses it only through the casters whose emitters look
+  // small from them, and compiles it only where there is one (resolveManifold, shader_features.h).
+  ManifoldMode manifold = ManifoldMode::Auto;
   RenderMode mode = RenderMode::Path;
   // Compile every material feature into the path tracer, whatever the scene uses (the shader is
   // otherwise specialised to the scene's features): measures what specialisation saves
@@ -106,6 +112,7 @@ std::string settingText(bool v);  // "on" | "off"
 std::string settingText(const std::string& v);
 std::string settingText(Integrator v);
 std::string settingText(DispersionMode v);
+std::string settingText(ManifoldMode v);
 std::string settingText(RenderMode v);
 
 // What changing the settings from `from` to `to` asks of a renderer. Every change restarts

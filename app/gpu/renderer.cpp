@@ -261,7 +261,7 @@ void Renderer::prepareMode() {
 }
 
 std::vector<std::string> Renderer::shaderDefines() const {
-  std::vector<std::string> d = variantFeatures(sceneFeatures_, settings_, features_).defines();  // shader_features.cpp
+  std::vector<std::string> d = variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_), features_).defines();  // shader_features.cpp
   // The TriShade word layout and split (split_buffers.glsl, tri_shade.glsl) follow the data, also
   // under allFeatures (whose CAUSTICA_TEXTURES and CAUSTICA_VERTEX_COLORS must not make a scene without
   // texcoords or colours read them).
@@ -272,8 +272,10 @@ std::vector<std::string> Renderer::shaderDefines() const {
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
-  // The caustic photon pass, once per scene, before the first variant with manifold NEE runs.
-  if (!causticCells_.built() && std::find(defines.begin(), defines.end(), "CAUSTICA_MANIFOLD") != defines.end())
+  // The caustic photon pass, once per scene and set of casters (manifoldCasterMask), before the first
+  // variant with manifold NEE runs.
+  if ((!causticCells_.built() || cellCasters_ != manifoldCasterMask(settings_.manifold, gpuScene_)) &&
+      std::find(defines.begin(), defines.end(), "CAUSTICA_MANIFOLD") != defines.end())
     buildCausticCells();
   const char* entry = renderModeSpec(settings_.mode).entryShader;
   if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
@@ -318,7 +320,8 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   if (!change.restart) return change;
   // Another variant whenever a row of the feature table turns on or off, whichever field its settings
   // test reads.
-  change.shader = change.shader || !(variantFeatures(sceneFeatures_, settings_) == variantFeatures(sceneFeatures_, settings));
+  change.shader = change.shader || !(variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_)) ==
+                                    variantFeatures(sceneFeatures_, resolveManifold(settings, gpuScene_)));
   if (change.resize) checkImageSize(limits_, settings.width, settings.height);
   const RenderSettings previous = settings_;
   settings_ = settings;
@@ -354,6 +357,7 @@ void Renderer::buildCausticCells() {
   frameUbo_.update(0, sizeof fp, &fp);
   bindSceneForDispatch();
   gpu::CasterParams cp = casterParams();
+  cellCasters_ = cp.count.w;
   causticCells_.build(photons, cp, [&](const gpu::CasterParams& built) {
     cellTableMask_ = built.count.z;
     uploadCasters();
@@ -364,6 +368,7 @@ void Renderer::buildCausticCells() {
 gpu::CasterParams Renderer::casterParams() const {
   gpu::CasterParams cp{};
   cp.count.z = cellTableMask_;
+  cp.count.w = manifoldCasterMask(settings_.manifold, gpuScene_);  // the photon pass's casters
   cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
   cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, 0.0f, 0.0f);
   cp.lights = gpuScene_.emitterSphere;
@@ -484,7 +489,7 @@ int Renderer::samplesPerDispatch() const {
   if (renderModeSpec(settings_.mode).samples != SampleRule::Regeneration) return 1;
   const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
   int perSample = settings_.maxDepth;
-  if (variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
+  if (variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_)).has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
   return std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
 }
 

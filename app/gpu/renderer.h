@@ -170,7 +170,7 @@ class Renderer {
   Image image() const;  // mean radiance per pixel (linear); with hasAlpha() also the alpha (coverage)
   // --background transparent in a mode that tracks coverage (the CAUSTICA_TRANSPARENT row): image()
   // has alpha = the fraction of a pixel's samples whose camera ray hit the scene (coverage.glsl).
-  bool hasAlpha() const { return variantFeatures(sceneFeatures_, settings_).has("CAUSTICA_TRANSPARENT"); }
+  bool hasAlpha() const { return variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_)).has("CAUSTICA_TRANSPARENT"); }
   // Tone-maps the accumulation (with `denoised`, denoise()'s output) into the rgba8 display texture (viewer).
   const GlTexture& updateDisplay(const ToneMapSettings& tone, bool denoised = false);
   // Milliseconds the last denoise() took on the GPU (it waits for the GPU to finish); 0 before any.
@@ -193,6 +193,9 @@ class Renderer {
   std::vector<std::string> shaderDefines() const;
   // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
+  // Binds the scene's storage blocks, UBOs and textures as the compute shaders read them (before each
+  // dispatch; also for GPU tests that run a library function over the scene in their own entry shader).
+  void bindSceneForDispatch();
 
  private:
   const GlProgram& program();
@@ -205,7 +208,6 @@ class Renderer {
   gpu::CasterParams casterParams() const;  // the caster UBO for the current settings and cells
   // The caustic photon pass (caustic_cells.h), once per scene, before the first manifold NEE variant runs.
   void buildCausticCells();
-  void bindSceneForDispatch();  // the scene's storage blocks, UBOs and textures, as the compute shaders read them
   // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
   void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
@@ -236,7 +238,8 @@ class Renderer {
   ShadingTextures shadingTextures_;  // the shading's views of the materials, light-tree and texture buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
-  std::uint32_t cellTableMask_ = 0;  // CasterParams::count.z: the caustic cell table's bucket mask, once built
+  std::uint32_t cellTableMask_ = 0;
+  std::uint32_t cellCasters_ = 0;    // the casters (manifoldCasterMask) the cell table was built for  // CasterParams::count.z: the caustic cell table's bucket mask, once built
   CausticCells causticCells_;
   std::vector<LightGroup> lightGroups_;
   gpu::PointLights pointLights_{};

@@ -2,6 +2,7 @@
 // and the two questions asked of it: what a scene needs, and what one shader variant compiles.
 #include "gpu/shader_features.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "util/error.h"
@@ -101,9 +102,10 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
       {"manifold", "CAUSTICA_MANIFOLD", K::Integrator,
        "manifold next-event estimation: light joined to the first diffuse vertex through one glass or mirror "
        "caster (glsl/lib/path_manifold.glsl), after a caustic photon pass",
-       "mis, a caustic caster, an emissive triangle and --manifold on", nullptr,
+       "mis, a caustic caster, an emissive triangle and --manifold on, or --manifold auto (the default; "
+       "resolveManifold) and a caster the emitters look small from (manifoldAutoEligible)", nullptr,
        [](const SceneView& v) { return !v.gpu.casters.empty() && v.gpu.emitterCount > 0; },
-       [](const RenderSettings& s) { return s.manifold; }, "CAUSTICA_MIS", A::Keep},
+       [](const RenderSettings& s) { return s.manifold == ManifoldMode::On; }, "CAUSTICA_MIS", A::Keep},
       {"no-emitters", "CAUSTICA_NO_EMITTERS", K::Integrator,
        "leaves the emitter estimate and the emitter-hit pdf out of mis rather than run them masked on every "
        "bounce (llvmpipe runs every branch)",
@@ -192,6 +194,20 @@ FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settin
     f.set(i, on);
   }
   return f;
+}
+
+std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g) {
+  std::uint32_t mask = 0;
+  const std::size_t n = std::min<std::size_t>(g.casters.size(), CAUSTICA_MAX_CASTERS);
+  for (std::size_t i = 0; i < n; ++i)
+    if (m == ManifoldMode::On || (m == ManifoldMode::Auto && g.casters[i].manifoldAuto)) mask |= 1u << i;
+  return g.emitterCount > 0 ? mask : 0u;
+}
+
+RenderSettings resolveManifold(RenderSettings s, const GpuScene& g) {
+  if (s.manifold == ManifoldMode::Auto)
+    s.manifold = manifoldCasterMask(ManifoldMode::Auto, g) != 0 ? ManifoldMode::On : ManifoldMode::Off;
+  return s;
 }
 
 FeatureSet modeFeatureRows(RenderMode m) {

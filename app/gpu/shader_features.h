@@ -86,6 +86,14 @@ FeatureSet detectFeatures(const Scene& scene, const GpuScene& gpu);
 // tracer), the output rows when `featureBuffers`, with --all-features applied (path tracer only) and
 // each row's `needs` checked.
 FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settings, bool featureBuffers = false);
+// The casters the caustic photon pass sends photons to under manifold mode m (bit i: caster i; the
+// cell table holds no other caster's cells, so manifold NEE and its MIS weight skip them alike): every
+// caster under On, those with CausticCaster::manifoldAuto under Auto, none under Off or without emitters.
+std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g);
+// The settings with --manifold auto decided for the scene: On where manifoldCasterMask(Auto) holds a
+// caster, else Off (the manifold row's settings test reads On; a scene where auto finds no caster
+// compiles the same variant as off). What the Renderer asks variantFeatures with.
+RenderSettings resolveManifold(RenderSettings s, const GpuScene& g);
 // Every row the mode's entry shader can read (what the shader tests compile combinations of).
 FeatureSet modeFeatureRows(RenderMode mode);
 

@@ -8,6 +8,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "shading/microfacet.h"
+
 namespace caustica {
 
 namespace {
@@ -74,25 +76,27 @@ std::vector<CausticCaster> findCausticCasters(const Scene& scene, int maxCasters
       if (!inserted) uf.unite(k, it->second);
     }
   std::unordered_map<std::uint32_t, std::vector<glm::vec3>> components;
-  std::unordered_map<std::uint32_t, bool> refractive;
+  std::unordered_map<std::uint32_t, bool> refractive, smooth;
   for (std::uint32_t k = 0; k < tris.size(); ++k) {
     std::uint32_t root = uf.find(k);
     const Triangle& t = scene.triangles[tris[k]];
+    const Material& m = scene.materials[t.material];
     components[root].insert(components[root].end(), std::begin(t.p), std::end(t.p));
-    refractive[root] |= scene.materials[t.material].transmission > 0.0f;
+    refractive[root] |= m.transmission > 0.0f;
+    smooth[root] |= m.roughness * m.roughness < kDeltaAlpha;  // a texture only lowers roughness
   }
 
   float diagonal = scene.bounds.empty() ? 0.0f : glm::length(scene.bounds.max - scene.bounds.min);
   struct Object {
     glm::vec4 sphere;
-    bool refractive;
+    bool refractive, smooth;
     std::vector<glm::vec3> points;
   };
   std::vector<Object> objects;
   for (auto& [root, pts] : components) {
     glm::vec4 s = boundingSphere(pts);
     if (!(s.w > 0.0f) || !std::isfinite(s.w) || s.w > 0.25f * diagonal) continue;
-    objects.push_back({s, refractive[root], std::move(pts)});
+    objects.push_back({s, refractive[root], smooth[root], std::move(pts)});
   }
   // Deterministic order whatever the hash map did: by centre, then radius.
   std::sort(objects.begin(), objects.end(), [](const Object& a, const Object& b) {
@@ -102,7 +106,7 @@ std::vector<CausticCaster> findCausticCasters(const Scene& scene, int maxCasters
   });
   if (objects.size() <= static_cast<size_t>(maxCasters)) {
     std::vector<CausticCaster> out;
-    for (const auto& o : objects) out.push_back({o.sphere, o.refractive});
+    for (const auto& o : objects) out.push_back({o.sphere, o.refractive, o.smooth});
     return out;
   }
 
@@ -118,14 +122,43 @@ std::vector<CausticCaster> findCausticCasters(const Scene& scene, int maxCasters
   for (int g = 0; g < maxCasters; ++g) {
     size_t begin = n * g / maxCasters, end = n * (g + 1) / maxCasters;
     std::vector<glm::vec3> pts;
-    bool refracts = false;
+    bool refracts = false, anySmooth = false;
     for (size_t i = begin; i < end; ++i) {
       pts.insert(pts.end(), objects[i].points.begin(), objects[i].points.end());
       refracts |= objects[i].refractive;
+      anySmooth |= objects[i].smooth;
     }
-    if (!pts.empty()) out.push_back({boundingSphere(pts), refracts});
+    if (!pts.empty()) out.push_back({boundingSphere(pts), refracts, anySmooth});
   }
   return out;
+}
+
+float triangleSolidAngle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const double la = glm::length(glm::dvec3(a)), lb = glm::length(glm::dvec3(b)), lc = glm::length(glm::dvec3(c));
+  const glm::dvec3 da(a), db(b), dc(c);
+  const double num = std::abs(glm::dot(da, glm::cross(db, dc)));
+  const double den = la * lb * lc + glm::dot(da, db) * lc + glm::dot(da, dc) * lb + glm::dot(db, dc) * la;
+  return static_cast<float>(2.0 * std::atan2(num, den));
+}
+
+bool manifoldAutoEligible(const CausticCaster& c) {
+  return c.smooth && c.emitterSolidAngle > 0.0f && c.emitterSolidAngle < kManifoldAutoSolidAngle;
+}
+
+void rateCastersForManifold(std::vector<CausticCaster>& casters, const Scene& emitters) {
+  for (CausticCaster& c : casters) {
+    const glm::vec3 centre(c.sphere);
+    double sum = 0.0;
+    for (const Triangle& t : emitters.triangles) {
+      if (t.material >= emitters.materials.size() || !emitters.materials[t.material].isEmissive()) continue;
+      const glm::vec3 a = t.p[0] - centre, b = t.p[1] - centre, d = t.p[2] - centre;
+      const glm::vec3 n = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);  // the emitting (front) side
+      if (!emitters.materials[t.material].doubleSided && !(glm::dot(n, -(a + b + d)) > 0.0f)) continue;
+      sum += triangleSolidAngle(a, b, d);
+    }
+    c.emitterSolidAngle = static_cast<float>(sum);
+    c.manifoldAuto = manifoldAutoEligible(c);
+  }
 }
 
 glm::vec4 emitterBoundingSphere(const Scene& scene) {

@@ -119,19 +119,13 @@ struct ManifoldResult {
   vec3 filt;
 };
 
-// Traces the chain from x along the direction of parameters ab about the caster's axis, with the
-// derivatives of everything with respect to ab; returns the chain's end on y's plane in res and the
-// residual F and its Jacobian J (in the light plane's orthonormal basis), and in `converged` whether
-// the chain ends at y. False when the chain leaves the caster, meets a surface that is not the
-// expected smooth specular one, or misses the plane.
-bool traceManifoldChain(ManifoldQuery q, vec2 ab, inout ManifoldResult res, out vec2 F, out mat2 J, out bool converged) {
-  converged = false;
-  F = vec2(0.0);
-  J = mat2(1.0);
+// The ray leaving x along the direction of parameters ab (gnomonic about the caster's axis, its
+// basis t, b) and its derivatives with respect to ab; wLen: the length of the unnormalised direction.
+RayDiff chainStartRay(ManifoldQuery q, vec2 ab, out float wLen) {
   vec3 t, b;
   orthonormalBasis(q.axis, t, b);
   vec3 wRaw = q.axis + ab.x * t + ab.y * b;
-  float wLen = length(wRaw);
+  wLen = length(wRaw);
   RayDiff r;
   r.o = q.x;
   r.d = wRaw / wLen;
@@ -139,89 +133,84 @@ bool traceManifoldChain(ManifoldQuery q, vec2 ab, inout ManifoldResult res, out 
   r.oB = vec3(0.0);
   r.dA = (t - r.d * dot(r.d, t)) / wLen;
   r.dB = (b - r.d * dot(r.d, b)) / wLen;
-  res.w = r.d;
-  res.ab = ab;
-  res.throughput = vec3(1.0);
-  res.eventProb = 1.0;
-  bool refractive = (casters.count.y & (1u << q.caster)) != 0u;
-  uint events = refractive ? 2u : 1u;
-  vec3 org = q.xOrg;
-  vec3 sigma = q.sigma;
-  bool ok = true;
-  uint k = 0u;
-  do {
-    Hit hit;
-    if (!traceClosest(org, r.d, 3.0e38, hit)) {
-      ok = false;
-      break;
-    }
-    HitTriangle h = hitTriangle(hit);
-    Surface sf;
-    if (!surfaceOn(hit, h, r.d, false, sf) || casterOwning(sf.p) != q.caster) {
-      ok = false;
-      break;
-    }
+  return r;
+}
+
+// One specular event of the chain: r (leaving org, in a medium of absorption sigma) meets the caster
+// and refracts (a glass caster) or reflects (a mirror) through its smooth lobe; r, org and sigma move
+// past the event and res gathers its throughput and probability. False when r misses the caster or
+// the surface there cannot make the event.
+bool chainEvent(ManifoldQuery q, bool refractive, inout RayDiff r, inout vec3 org, inout vec3 sigma,
+                inout ManifoldResult res) {
+  Hit hit;
+  if (!traceClosest(org, r.d, 3.0e38, hit)) return false;
+  HitTriangle h = hitTriangle(hit);
+  Surface sf;
+  if (!surfaceOn(hit, h, r.d, false, sf) || casterOwning(sf.p) != q.caster) return false;
 #ifdef CAUSTICA_VOLUME
-    res.throughput *= exp(-sigma * hit.t);
+  res.throughput *= exp(-sigma * hit.t);
 #endif
-    NormalDiff nd = normalDiffOn(hit, h, sf.ns);
-    vec3 pA = transferDiff(r.oA, r.dA, r.d, hit.t, sf.ng);
-    vec3 pB = transferDiff(r.oB, r.dB, r.d, hit.t, sf.ng);
-    vec3 nA = normalDerivative(nd, sf.ns, pA);
-    vec3 nB = normalDerivative(nd, sf.ns, pB);
-    vec2 metalRough = materialMetalRough(sf.m, sf.uv);
-    vec3 color = materialBaseColor(sf.m, sf.uv, sf.color).rgb;
-    bool isSmooth = metalRough.y * metalRough.y < kDeltaAlpha;
-    vec3 dNew, dA, dB;
-    if (refractive) {
-      float weight = (1.0 - metalRough.x) * sf.m.params.z;  // the glass lobe's probability
-      float ior = sf.m.params.w;
+  NormalDiff nd = normalDiffOn(hit, h, sf.ns);
+  vec3 pA = transferDiff(r.oA, r.dA, r.d, hit.t, sf.ng);
+  vec3 pB = transferDiff(r.oB, r.dB, r.d, hit.t, sf.ng);
+  vec3 nA = normalDerivative(nd, sf.ns, pA);
+  vec3 nB = normalDerivative(nd, sf.ns, pB);
+  vec2 metalRough = materialMetalRough(sf.m, sf.uv);
+  vec3 color = materialBaseColor(sf.m, sf.uv, sf.color).rgb;
+  bool isSmooth = metalRough.y * metalRough.y < kDeltaAlpha;
+  vec3 dNew, dA, dB;
+  if (refractive) {
+    float weight = (1.0 - metalRough.x) * sf.m.params.z;  // the glass lobe's probability
+    float ior = sf.m.params.w;
 #ifdef CAUSTICA_DISPERSION
-      if ((sf.m.tex.z & kMatDispersive) != 0u) {
-        if (res.lambda == 0.0) pickWavelength(q.uLambda, res.lambda, res.filt);
-        ior = cauchyIor(ior, sf.m.absorption.w, res.lambda);
-      }
-#endif
-      float eta = sf.front ? ior : 1.0 / ior;
-      if (!(weight > 0.0) || !(isSmooth || ior == 1.0) ||
-          !refractDiff(r.d, sf.ns, 1.0 / eta, dNew, r.dA, nA, dA, r.dB, nB, dB) || dot(dNew, sf.ng) >= 0.0) {
-        ok = false;
-        break;
-      }
-      float fresnel = fresnelDielectric(-dot(r.d, sf.ns), eta);
-      res.eventProb *= weight * (1.0 - fresnel);
-      res.throughput *= color * (weight * (1.0 - fresnel) / (eta * eta));
-#ifdef CAUSTICA_VOLUME
-      sigma = mediumBeyond(sf);
-#endif
-      org = offsetRayOrigin(sf.p, sf.pError, -sf.ng);
-      res.ngLast = -sf.ng;
-    } else {
-      float weight = metalRough.x;  // the mirror lobe's probability
-      dNew = reflect(r.d, sf.ns);
-      if (!(weight > 0.0) || !isSmooth || dot(dNew, sf.ng) <= 0.0) {
-        ok = false;
-        break;
-      }
-      dA = reflectDiff(r.d, sf.ns, r.dA, nA);
-      dB = reflectDiff(r.d, sf.ns, r.dB, nB);
-      res.eventProb *= weight;
-      res.throughput *= color * weight;
-      org = offsetRayOrigin(sf.p, sf.pError, sf.ng);
-      res.ngLast = sf.ng;
+    if ((sf.m.tex.z & kMatDispersive) != 0u) {
+      if (res.lambda == 0.0) pickWavelength(q.uLambda, res.lambda, res.filt);
+      ior = cauchyIor(ior, sf.m.absorption.w, res.lambda);
     }
-    r.o = sf.p;
-    r.oA = pA;
-    r.oB = pB;
-    r.d = dNew;
-    r.dA = dA;
-    r.dB = dB;
-    res.pLast = sf.p;
-    res.pLastError = sf.pError;
-  } while (++k < events);
-  if (!ok) return false;
-  // The exit ray on the plane through y facing the caster (normal nP): F = its point minus y, in the
-  // plane's basis (better conditioned than the light triangle's own plane, which may face anywhere).
+#endif
+    float eta = sf.front ? ior : 1.0 / ior;
+    if (!(weight > 0.0) || !(isSmooth || ior == 1.0) ||
+        !refractDiff(r.d, sf.ns, 1.0 / eta, dNew, r.dA, nA, dA, r.dB, nB, dB) || dot(dNew, sf.ng) >= 0.0)
+      return false;
+    float fresnel = fresnelDielectric(-dot(r.d, sf.ns), eta);
+    res.eventProb *= weight * (1.0 - fresnel);
+    res.throughput *= color * (weight * (1.0 - fresnel) / (eta * eta));
+#ifdef CAUSTICA_VOLUME
+    sigma = mediumBeyond(sf);
+#endif
+    org = offsetRayOrigin(sf.p, sf.pError, -sf.ng);
+    res.ngLast = -sf.ng;
+  } else {
+    float weight = metalRough.x;  // the mirror lobe's probability
+    dNew = reflect(r.d, sf.ns);
+    if (!(weight > 0.0) || !isSmooth || dot(dNew, sf.ng) <= 0.0) return false;
+    dA = reflectDiff(r.d, sf.ns, r.dA, nA);
+    dB = reflectDiff(r.d, sf.ns, r.dB, nB);
+    res.eventProb *= weight;
+    res.throughput *= color * weight;
+    org = offsetRayOrigin(sf.p, sf.pError, sf.ng);
+    res.ngLast = sf.ng;
+  }
+  r.o = sf.p;
+  r.oA = pA;
+  r.oB = pB;
+  r.d = dNew;
+  r.dA = dA;
+  r.dB = dB;
+  res.pLast = sf.p;
+  res.pLastError = sf.pError;
+  return true;
+}
+
+// The chain's exit ray r on the plane through y facing the caster (normal nP): F = its point minus y,
+// in the plane's basis (better conditioned than the light triangle's own plane, which may face
+// anywhere), its Jacobian J, the solution's area per solid angle at x (wLen: chainStartRay's) and
+// whether it converged. False when r does not reach the plane.
+bool chainResidual(ManifoldQuery q, RayDiff r, float wLen, inout ManifoldResult res, out vec2 F, out mat2 J,
+                   out bool converged) {
+  converged = false;
+  F = vec2(0.0);
+  J = mat2(1.0);
   vec3 e = r.o - q.y;
   vec3 nP = normalize(casters.sphere[q.caster].xyz - q.y);
   float dn = dot(r.d, nP);
@@ -242,6 +231,34 @@ bool traceManifoldChain(ManifoldQuery q, vec2 ab, inout ManifoldResult res, out 
   res.areaPerSolidAngle = detJ * wLen * wLen * wLen * abs(dn) / abs(dot(r.d, q.nL));
   converged = length(diff) <= kManifoldTolerance * length(e);
   return true;
+}
+
+// Traces the chain from x along the direction of parameters ab about the caster's axis, with the
+// derivatives of everything with respect to ab (chainStartRay, then chainEvent per specular event,
+// then chainResidual); returns the chain's end on y's plane in res and the residual F and its
+// Jacobian J (in the light plane's orthonormal basis), and in `converged` whether the chain ends at
+// y. False when the chain leaves the caster, meets a surface that is not the expected smooth
+// specular one, or misses the plane.
+bool traceManifoldChain(ManifoldQuery q, vec2 ab, inout ManifoldResult res, out vec2 F, out mat2 J, out bool converged) {
+  converged = false;
+  F = vec2(0.0);
+  J = mat2(1.0);
+  float wLen;
+  RayDiff r = chainStartRay(q, ab, wLen);
+  res.w = r.d;
+  res.ab = ab;
+  res.throughput = vec3(1.0);
+  res.eventProb = 1.0;
+  bool refractive = (casters.count.y & (1u << q.caster)) != 0u;
+  uint events = refractive ? 2u : 1u;
+  vec3 org = q.xOrg;
+  vec3 sigma = q.sigma;
+  bool ok = true;
+  uint k = 0u;
+  do {
+    ok = chainEvent(q, refractive, r, org, sigma, res);
+  } while (ok && ++k < events);
+  return ok && chainResidual(q, r, wLen, res, F, J, converged);
 }
 
 // Newton's method on the direction leaving x, from the caster's centre (ab = 0): each step traces the

@@ -26,9 +26,10 @@ uint casterChainEvents(uint caster) { return casterRefracts(caster) ? 2u : 1u; }
 // alone, so a bounce from x finds the same casters, counts and directions later.
 uvec2 manifoldCasters(vec3 p, vec3 n, out vec3 dirs[CAUSTICA_MAX_CASTERS]) {
   uvec2 counts = uvec2(0u);
-  for (uint i = 0u; i < uint(CAUSTICA_MAX_CASTERS); ++i) {
-    dirs[i] = vec3(0.0);
-    if (i >= casters.count.x) continue;
+  for (uint i = 0u; i < uint(CAUSTICA_MAX_CASTERS); ++i) dirs[i] = vec3(0.0);
+  uint i = 0u;
+  do {  // bottom-tested, over the scene's casters only (count.x >= 1 where this is compiled): llvmpipe
+        // runs a masked body per iteration, so a loop to CAUSTICA_MAX_CASTERS paid 8 cell lookups a bounce
     uvec4 cell = casterCell(i, p);
     vec3 d = vec3(ivec3(cell.yzw));
     float len = length(d);
@@ -38,7 +39,7 @@ uvec2 manifoldCasters(vec3 p, vec3 n, out vec3 dirs[CAUSTICA_MAX_CASTERS]) {
       if (i < 4u) counts.x |= c;
       else counts.y |= c;
     }
-  }
+  } while (++i < casters.count.x);
   return counts;
 }
 

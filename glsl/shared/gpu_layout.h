@@ -285,7 +285,8 @@ struct FrameParams {
 struct CasterParams {
   uvec4 count;                            // x: spheres in use (0..CAUSTICA_MAX_CASTERS); y: bit i set = sphere i refracts;
                                           // z: buckets of the caustic cell table - 1 (a power of 2 minus 1; manifold NEE,
-                                          // caustic_cells.glsl), 0: no table; w unused
+                                          // caustic_cells.glsl), 0: no table; w: bit i set = the photon pass sends
+                                          // photons to sphere i (manifoldCasterMask; caustic_photons.comp only)
   vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians); zw unused
   vec4 lights;                            // xyz: centre, w: radius of a sphere around every emitter (world space)
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)

@@ -34,7 +34,7 @@ struct BlockStats {
 BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
                       int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth,
                       float casterProbability = 0.5f, std::vector<std::string>* defines = nullptr,
-                      bool manifold = false) {
+                      ManifoldMode manifold = ManifoldMode::Off) {
   BlockStats b;
   b.blocksX = w / block;
   b.blocksY = h / block;
@@ -369,7 +369,7 @@ std::array<BlockStats, 3> checkManifoldAgrees(const std::string& what, const Sce
   BlockStats mis =
       blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 800, &nonFinite, 32, 0.5f, &misDefines);
   BlockStats manifold = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 900, &nonFinite, 32, 0.5f,
-                                   &manifoldDefines, true);
+                                   &manifoldDefines, ManifoldMode::On);
   REQUIRE_FALSE(hasDefine(misDefines, "CAUSTICA_MANIFOLD"));
   REQUIRE(hasDefine(manifoldDefines, "CAUSTICA_MANIFOLD"));
   checkBlocksAgree(what + ", naive against manifold NEE", naive, manifold, naiveBlocks);
@@ -412,6 +412,62 @@ TEST_CASE("manifold NEE matches naive and mis: mirror-caustic") {
   // Naive reaches the small lamp in too few samples per block (some blocks none: no variance to test
   // against); it is compared on the image, its quadrants and the caustic region.
   checkManifoldAgrees("mirror-caustic", scene, 40, 40, 4, 128 * f, 32 * f, 3, 5, 7, 8, false);
+}
+
+TEST_CASE("manifold auto: the off variant bit for bit where no caster qualifies, the on one where all do") {
+  // cornell-glass: a large lamp over both spheres (docs/path-tracer.md): no caster qualifies, the same
+  // shader and the same bits as --manifold off. lamp-caustics: both casters under a 4-cm lamp qualify,
+  // so the photon pass fills the same cells as under --manifold on: the same bits as on.
+  for (const auto& [name, same] : {std::pair<const char*, ManifoldMode>{"cornell-glass", ManifoldMode::Off},
+                                   std::pair<const char*, ManifoldMode>{"lamp-caustics", ManifoldMode::On}}) {
+    CAPTURE(name);
+    Scene scene = loadScene(sourcePath(std::string("assets/scenes/") + name + ".gltf"));
+    const Camera cam = sceneCamera(scene);
+    RenderSettings autoSettings = smallSettings(24, 24);
+    REQUIRE(autoSettings.manifold == ManifoldMode::Auto);  // the default
+    RenderSettings other = autoSettings;
+    other.manifold = same;
+    RenderResult a = renderScene(scene, cam, autoSettings, 4), b = renderScene(scene, cam, other, 4);
+    CHECK(a.defines == b.defines);
+    CHECK(hasDefine(a.defines, "CAUSTICA_MANIFOLD") == (same == ManifoldMode::On));
+    CHECK(a.image.rgb == b.image.rgb);
+    RenderSettings off = autoSettings;
+    off.manifold = ManifoldMode::Off;
+    if (same == ManifoldMode::On) CHECK_FALSE(renderScene(scene, cam, off, 4).image.rgb == a.image.rgb);
+  }
+}
+
+TEST_CASE("manifold auto: through the qualifying casters only, it matches mis without manifold NEE") {
+  // A glass ball far under a 16-cm lamp (0.007 sr from its centre: qualifies) and a mirror ball close
+  // beside the lamp (0.04 sr: does not): auto sends photons through the glass ball only, and the
+  // bounce through the mirror keeps weight 1 (no cells of its caster). Any mismatch between the two
+  // MIS sides (a weight for paths manifold NEE cannot make through the mirror) shows as a bias.
+  Scene s;
+  Material mirror = diffuseMaterial(0.9f);
+  mirror.metallic = 1.0f;
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(60.0f), glassMaterial(1.5f), mirror};
+  addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);
+  const float h = 0.08f;
+  addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);
+  addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
+  addSphere(s, {0.5f, 2.0f, 0.0f}, 0.15f, 16, 3);
+  finishBounds(s);
+  s.cameras.push_back(lookAt({0.0f, 1.4f, 1.9f}, {0.0f, 0.0f, 0.0f}, 0.9f));
+  const GpuScene g = packScene(s, buildBvh(s.triangles));
+  REQUIRE(g.casters.size() == 2);
+  CHECK(manifoldCasterMask(ManifoldMode::Auto, g) != 0u);
+  CHECK(manifoldCasterMask(ManifoldMode::Auto, g) != manifoldCasterMask(ManifoldMode::On, g));
+  const int n = 32, block = 4, renders = 8, f = longTests() ? 4 : 1;
+  std::uint64_t nonFinite = 0;
+  std::vector<std::string> offDefines, autoDefines;
+  BlockStats off = blockStats(s, s.cameras[0], Integrator::Mis, n, n, block, 64 * f, renders, 800, &nonFinite, 32, 0.5f,
+                              &offDefines, ManifoldMode::Off);
+  BlockStats autoStats = blockStats(s, s.cameras[0], Integrator::Mis, n, n, block, 64 * f, renders, 900, &nonFinite, 32,
+                                    0.5f, &autoDefines, ManifoldMode::Auto);
+  REQUIRE(hasDefine(autoDefines, "CAUSTICA_MANIFOLD"));
+  REQUIRE_FALSE(hasDefine(offDefines, "CAUSTICA_MANIFOLD"));
+  checkBlocksAgree("glass and mirror balls, auto against off", off, autoStats);
+  CHECK(nonFinite == 0);
 }
 
 namespace {
@@ -506,9 +562,9 @@ void checkManifoldUnbiased(const std::string& what, const Scene& scene, const Ma
   RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
   settings.dispersion = dispersion;
   settings.maxDepth = 32;
-  settings.manifold = true;
+  settings.manifold = ManifoldMode::On;
   const PixelStats manifold = pixelStats(scene, view.camera, settings, view.sppManifold * f, renders, 5000, &nonFinite);
-  settings.manifold = false;
+  settings.manifold = ManifoldMode::Off;
   const PixelStats mis = pixelStats(scene, view.camera, settings, view.sppMis * f, renders, 6000, &nonFinite);
   REQUIRE(hasDefine(manifold.defines, "CAUSTICA_MANIFOLD"));
   REQUIRE_FALSE(hasDefine(mis.defines, "CAUSTICA_MANIFOLD"));
@@ -641,7 +697,7 @@ TEST_CASE("manifold NEE is unbiased: instanced caster") {
   flattenInstances(flat);
   const Camera focus = causticFocusCamera(inst, 0.03);
   RenderSettings settings = smallSettings(16, 16, Integrator::Mis, 3);
-  settings.manifold = true;
+  settings.manifold = ManifoldMode::On;
   const RenderResult a = renderScene(inst, focus, settings, 256, 64);
   const RenderResult b = renderScene(flat, focus, settings, 256, 64);
   REQUIRE(hasDefine(a.defines, "CAUSTICA_INSTANCED"));

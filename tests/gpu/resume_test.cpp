@@ -19,7 +19,7 @@ TEST_CASE("resume from a checkpoint: 8 spp + 8 spp equals 16 spp bit for bit") {
     Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
     Camera camera = sceneCamera(scene);
     RenderSettings rs = smallSettings(16, 12, Integrator::Mis, 11);
-    rs.manifold = manifold;
+    rs.manifold = manifold ? ManifoldMode::On : ManifoldMode::Off;
     ShaderLibrary& library = testShaderLibrary();
     std::string path = (std::filesystem::temp_directory_path() / "caustica-resume-test.ckpt").string();
 

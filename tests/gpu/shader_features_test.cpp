@@ -288,11 +288,12 @@ TEST_CASE("shader features: a variant compiles the rows its mode reads, its sett
   // Manifold NEE only when asked and only where the scene has a caster and an emitter: a scene without
   // casters compiles the same variant with --manifold on as off (it pays nothing).
   s = path;
-  s.manifold = true;
+  s.manifold = ManifoldMode::On;
   CHECK(variantFeatures(rows({"CAUSTICA_MIS"}), s) == variantFeatures(rows({"CAUSTICA_MIS"}), path));
   const FeatureSet caustic = rows({"CAUSTICA_GLASS", "CAUSTICA_MIS", "CAUSTICA_CASTERS", "CAUSTICA_MANIFOLD"});
   CHECK(joined(variantFeatures(caustic, s).defines()) == "CAUSTICA_GLASS CAUSTICA_MIS CAUSTICA_CASTERS CAUSTICA_MANIFOLD");
-  CHECK_FALSE(variantFeatures(caustic, path).has("CAUSTICA_MANIFOLD"));  // off by default
+  // Auto is decided per scene by resolveManifold before the table is asked; unresolved it reads as off.
+  CHECK_FALSE(variantFeatures(caustic, path).has("CAUSTICA_MANIFOLD"));
   s.integrator = Integrator::Naive;
   CHECK_FALSE(variantFeatures(caustic, s).has("CAUSTICA_MANIFOLD"));  // needs mis
 

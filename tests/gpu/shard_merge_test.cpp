@@ -120,7 +120,7 @@ TEST_CASE("shards merged equal one render: manifold NEE (its photon pass the sam
   rs.width = 24;
   rs.height = 18;
   rs.seed = 7;
-  rs.manifold = true;
+  rs.manifold = ManifoldMode::On;
   checkShardsEqualOne(scene, rs, 12, {3});
 }
 

@@ -70,7 +70,7 @@ class BenchRunner {
     cacheDir_ = opts.get("--cache", defaultReferenceCacheDir());
     for (const auto& name : splitList(opts.get("--integrators", "naive,mis")))
       integrators_.push_back(parseEstimator(name));
-    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis, manifold");
+    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis, mis-off, manifold");
     // --adaptive: the integrators that also get an adaptive run (default mis; "none" for none).
     for (const auto& name : splitList(opts.get("--adaptive", "mis")))
       if (name != "none") adaptiveIntegrators_.push_back(parseEstimator(name));
@@ -384,16 +384,18 @@ class BenchRunner {
   BenchSetup setup_;  // GL renderer, backend and --max-seconds
   int referenceSpp_ = kDefaultReferenceSpp;
   std::string outDir_, cacheDir_;
-  // An estimator of --integrators: naive, mis, or manifold (mis with manifold NEE); mis takes --manifold.
+  // An estimator of --integrators: naive, mis (manifold NEE as --manifold says, default auto), mis-off
+  // (without manifold NEE) or manifold (mis with --manifold on).
   struct Estimator {
     Integrator integrator;
-    bool manifold;
+    ManifoldMode manifold;
     bool operator==(const Estimator& o) const { return integrator == o.integrator && manifold == o.manifold; }
   };
   Estimator parseEstimator(const std::string& name) const {
-    if (name == "manifold") return {Integrator::Mis, true};
+    if (name == "manifold") return {Integrator::Mis, ManifoldMode::On};
+    if (name == "mis-off") return {Integrator::Mis, ManifoldMode::Off};
     Integrator i = parseIntegrator(name);
-    return {i, i == Integrator::Mis && opts_.get("--manifold", "off") == "on"};
+    return {i, parseManifoldMode(opts_.get("--manifold", manifoldModeName(RenderSettings{}.manifold)))};
   }
   std::vector<Estimator> integrators_, adaptiveIntegrators_;
   std::vector<DispersionMode> dispersions_;

@@ -60,7 +60,8 @@ std::string estimatorName(const RenderSettings& settings, bool sceneHasCasters) 
   if (settings.integrator == Integrator::Mis && sceneHasCasters &&
       settings.casterProbability != RenderSettings{}.casterProbability)
     name += formatDouble(" casters=%g", settings.casterProbability);
-  if (settings.integrator == Integrator::Mis && sceneHasCasters && settings.manifold) name += " manifold";
+  if (settings.integrator == Integrator::Mis && sceneHasCasters && settings.manifold != RenderSettings{}.manifold)
+    name += std::string(" manifold=") + manifoldModeName(settings.manifold);
   return name;
 }
 

@@ -98,4 +98,10 @@ if(Python3_Interpreter_FOUND)
                    -DOUT=${CMAKE_CURRENT_BINARY_DIR}/run_all_smoke -P ${CMAKE_CURRENT_LIST_DIR}/run_all_smoke.cmake)
   set_tests_properties("bench: run-all --smoke fills every region of docs/benchmarks.md"
                        PROPERTIES ENVIRONMENT "LP_NUM_THREADS=2" TIMEOUT 300)
+  # bench/cycles-compare needs Blender, which caustica never does: without it, it must say so (exit 2).
+  add_test(NAME "bench: cycles-compare without Blender says so"
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/bench/cycles-compare --blender /nonexistent/blender
+                   --out ${CMAKE_CURRENT_BINARY_DIR}/cycles_compare_absent)
+  set_tests_properties("bench: cycles-compare without Blender says so"
+                       PROPERTIES PASS_REGULAR_EXPRESSION "Blender not found \\('/nonexistent/blender'\\)" TIMEOUT 30)
 endif()
