@@ -27,14 +27,7 @@ Scene instancedTestScene() {
   s.path = "instancing-test";
   s.materials = {diffuseMaterial(0.8f), diffuseMaterial(glm::vec3(0.8f, 0.25f, 0.2f)),
                  emitterMaterial(glm::vec3(1.5f, 1.4f, 1.25f)), metalMaterial(glm::vec3(0.9f))};
-  const auto mesh = [&](auto add) {
-    MeshRange r;
-    r.firstTriangle = std::uint32_t(s.triangles.size());
-    add();
-    r.triangleCount = std::uint32_t(s.triangles.size()) - r.firstTriangle;
-    s.meshes.push_back(r);
-    return std::uint32_t(s.meshes.size() - 1);
-  };
+  const auto mesh = [&](auto add) { return addMesh(s, add); };
   const std::uint32_t room = mesh([&] {
     addQuad(s, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, 0);     // floor, facing +y
     addQuad(s, {-2, 0, -2}, {2, 0, -2}, {2, 2.5f, -2}, {-2, 2.5f, -2}, 0);  // back wall, facing +z
@@ -55,11 +48,7 @@ Scene instancedTestScene() {
   instance(shiny, placed({0.6, 1.2, -1.3}, 10.0, {1, 0, 0}, {0.4, 0.4, 0.4}));
   instance(light, placed({-0.3, 2.4, 0.0}, 0.0, {0, 1, 0}, {1.2, 1.0, 0.9}));
   instance(light, placed({1.3, 2.2, -1.0}, 25.0, {0, 0, 1}, {-0.3, 1.0, 0.3}));  // mirrored, tilted
-  for (const Instance& in : s.instances) {
-    const MeshRange& m = s.meshes[in.mesh];
-    for (std::uint32_t i = m.firstTriangle; i < m.firstTriangle + m.triangleCount; ++i)
-      for (const glm::vec3& p : s.triangles[i].p) s.bounds.grow(glm::vec3(in.world * glm::dvec4(glm::dvec3(p), 1.0)));
-  }
+  finishInstancedBounds(s);
   return s;
 }
 

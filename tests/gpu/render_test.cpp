@@ -1,7 +1,7 @@
 // render_test.cpp — accuracy of the path tracer against ground truth on llvmpipe: furnaces with known
 // answers, an invisible glass sphere, naive vs MIS agreement (per block, and per region under curved
-// lights), a caustic where optics puts it, rgb vs spectral dispersion, reproducibility, and no
-// non-finite samples.
+// lights), a caustic where optics puts it, rgb vs spectral dispersion, manifold NEE against naive and
+// mis (image, quadrants and caustic regions), reproducibility, and no non-finite samples.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <numeric>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "shading/layers.h"
 #include "shading/microfacet.h"
@@ -239,13 +241,12 @@ TEST_CASE("Renderer::apply: a renderer whose settings changed renders what a new
 namespace {
 
 // A floor, a small light above it and a glass sphere between them whose focus lies on the floor.
-Scene causticScene(float dispersion) {
+Scene causticScene(float dispersion, float h = 0.15f) {
   Scene s;
   Material glass = glassMaterial(1.5f);
   glass.dispersion = dispersion;
   s.materials = {diffuseMaterial(0.8f), emitterMaterial(18.0f), glass};
   addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);  // floor, facing +y
-  float h = 0.15f;
   addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);               // light, facing -y
   addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
   finishBounds(s);
@@ -467,6 +468,249 @@ TEST_CASE("manifold auto: through the qualifying casters only, it matches mis wi
   REQUIRE_FALSE(hasDefine(offDefines, "CAUSTICA_MANIFOLD"));
   checkBlocksAgree("glass and mirror balls, auto against off", off, autoStats);
   CHECK(nonFinite == 0);
+}
+
+namespace {
+
+// Per-pixel grey level (mean of the channels) of `renders` independent renders (seeds seedBase,
+// seedBase + 1, ...) of 16 x 16 pixels: the mean of the renders and the variance of that mean. Pixels
+// are independent, so a region's variance is the sum of its pixels' over n^2: an estimate with
+// (renders - 1) x pixels degrees of freedom (768 for the whole image), whose k-sigma tolerance is
+// close to the normal distribution's.
+struct PixelStats {
+  int w = 0, h = 0;
+  std::vector<double> mean, var;
+  std::vector<std::string> defines;  // the shader variant of the renders
+};
+
+PixelStats pixelStats(const Scene& scene, const Camera& cam, RenderSettings settings, int spp, int renders,
+                      std::uint32_t seedBase, std::uint64_t* nonFinite) {
+  PixelStats p;
+  p.w = p.h = settings.width = settings.height = 16;
+  const size_t n = static_cast<size_t>(p.w) * p.h;
+  std::vector<std::vector<double>> per(renders, std::vector<double>(n));
+  for (int r = 0; r < renders; ++r) {
+    settings.seed = seedBase + static_cast<std::uint32_t>(r);
+    RenderResult res = renderScene(scene, cam, settings, spp, 64);
+    *nonFinite += res.stats.nonFinite;
+    p.defines = res.defines;
+    for (int y = 0; y < p.h; ++y)
+      for (int x = 0; x < p.w; ++x)
+        per[r][static_cast<size_t>(y) * p.w + x] = (res.image.at(x, y, 0) + res.image.at(x, y, 1) + res.image.at(x, y, 2)) / 3.0;
+  }
+  p.mean.assign(n, 0.0);
+  p.var.assign(n, 0.0);
+  for (size_t i = 0; i < n; ++i) {
+    for (int r = 0; r < renders; ++r) p.mean[i] += per[r][i] / renders;
+    for (int r = 0; r < renders; ++r) p.var[i] += (per[r][i] - p.mean[i]) * (per[r][i] - p.mean[i]) / (renders - 1);
+    p.var[i] /= renders;  // variance of the mean
+  }
+  return p;
+}
+
+// Mean and variance of the mean of the pixels [x0, x1) x [y0, y1) of `p`.
+std::pair<double, double> pixelRegion(const PixelStats& p, int x0, int y0, int x1, int y1) {
+  double m = 0.0, v = 0.0;
+  const double n = static_cast<double>(x1 - x0) * (y1 - y0);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      m += p.mean[static_cast<size_t>(y) * p.w + x] / n;
+      v += p.var[static_cast<size_t>(y) * p.w + x] / (n * n);
+    }
+  return {m, v};
+}
+
+// A pinhole camera at cam's position that sees the part [x0, x1] x [y0, y1] (normalized coordinates
+// of cam's square image, y down) of cam's view in a square image: the larger side of the box fills it.
+// A caustic region rendered on its own gets every sample of a render.
+Camera cropCamera(const Camera& cam, double x0, double y0, double x1, double y1) {
+  const glm::vec3 f = glm::normalize(cam.forward), r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
+  const float t = std::tan(0.5f * cam.yfov);
+  const float cx = static_cast<float>(x0 + x1) - 1.0f, cy = 1.0f - static_cast<float>(y0 + y1);
+  Camera c = cam;
+  c.forward = glm::normalize(f + cx * t * r + cy * t * u);
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, u), c.forward));
+  c.yfov = 2.0f * std::atan(t * static_cast<float>(std::max(x1 - x0, y1 - y0)));
+  c.aspect = 0.0f;
+  return c;
+}
+
+// The number of standard errors of the difference two estimates may differ by in the manifold NEE
+// unbiasedness tests. The standard errors come from hundreds of degrees of freedom (pixelStats), so
+// the false-failure rate per comparison is near the normal distribution's 7e-6.
+constexpr double kManifoldSigmas = 4.5;
+
+// One view of a manifold NEE unbiasedness case, rendered with each estimator at 16 x 16 pixels, 4
+// independent renders each: the scene's image or its caustic region alone (cropCamera).
+struct ManifoldView {
+  std::string name;
+  Camera camera;
+  int sppNaive, sppMis, sppManifold;  // per render; 0: leave naive out (a lamp it finds too rarely)
+  // Whether this view's mean against mis must resolve a 0.5 % bias (asserted: kManifoldSigmas standard
+  // errors of the difference <= 0.5 % of the mean).
+  bool sharp = false;
+};
+
+// Manifold NEE against mis without it and against naive over a view and its four quadrants: each
+// difference within kManifoldSigmas standard errors. Prints, per comparison, the smallest bias of the
+// view's mean the run resolves (kManifoldSigmas standard errors of the difference, relative to the
+// mean) and the largest over its quadrants. CAUSTICA_LONG_TESTS=1 takes longFactor times the samples.
+void checkManifoldUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view,
+                           DispersionMode dispersion = DispersionMode::Rgb, int longFactor = 4) {
+  const int f = longTests() ? longFactor : 1, renders = 4;
+  std::uint64_t nonFinite = 0;
+  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
+  settings.dispersion = dispersion;
+  settings.maxDepth = 32;
+  settings.manifold = ManifoldMode::On;
+  const PixelStats manifold = pixelStats(scene, view.camera, settings, view.sppManifold * f, renders, 5000, &nonFinite);
+  settings.manifold = ManifoldMode::Off;
+  const PixelStats mis = pixelStats(scene, view.camera, settings, view.sppMis * f, renders, 6000, &nonFinite);
+  REQUIRE(hasDefine(manifold.defines, "CAUSTICA_MANIFOLD"));
+  REQUIRE_FALSE(hasDefine(mis.defines, "CAUSTICA_MANIFOLD"));
+  std::vector<std::pair<std::string, PixelStats>> others{{"mis", mis}};
+  if (view.sppNaive > 0) {
+    settings.integrator = Integrator::Naive;
+    others.emplace_back("naive", pixelStats(scene, view.camera, settings, view.sppNaive * f, renders, 7000, &nonFinite));
+  }
+  CHECK(nonFinite == 0);
+  static const char* kQuadrant[] = {"", " top left", " top right", " bottom left", " bottom right"};
+  for (const auto& [name, other] : others) {
+    double worstQuadrant = 0.0;
+    for (int q = 0; q < 5; ++q) {
+      const int x0 = q == 0 ? 0 : (q - 1) % 2 * 8, y0 = q == 0 ? 0 : (q - 1) / 2 * 8, side = q == 0 ? 16 : 8;
+      const auto [mm, vm] = pixelRegion(manifold, x0, y0, x0 + side, y0 + side);
+      const auto [mo, vo] = pixelRegion(other, x0, y0, x0 + side, y0 + side);
+      const double se = std::sqrt(vm + vo), resolves = 100.0 * kManifoldSigmas * se / mo;
+      INFO(what, ", ", view.name, std::string(kQuadrant[q]), ": manifold ", mm, ", ", name, " ", mo, ", difference ",
+           100.0 * (mm - mo) / mo, " % = ", (mm - mo) / se, " standard errors (one: ", 100.0 * se / mo, " %)");
+      CHECK(mo > 0.0);
+      CHECK(std::abs(mm - mo) <= kManifoldSigmas * se);
+      if (q > 0) worstQuadrant = std::max(worstQuadrant, resolves);
+      if (q == 0) {
+        MESSAGE(what, ", ", view.name, ", manifold ", mm, " against ", name, " ", mo, ": difference ",
+                100.0 * (mm - mo) / mo, " % (", (mm - mo) / se, " standard errors); resolves a bias of ", resolves, " %");
+        if (name == "mis" && view.sharp) CHECK(resolves <= 0.5);
+      }
+    }
+    MESSAGE(what, ", ", view.name, " quadrants against ", name, ": resolve a bias of ", worstQuadrant, " % or less");
+  }
+}
+
+// causticScene's focus: the part of its 64 x 64 image within `r` (normalized) of the floor under the ball.
+Camera causticFocusCamera(const Scene& scene, double r) {
+  const glm::ivec2 c = project(scene.cameras[0], glm::vec3(0.0f), 64);
+  return cropCamera(scene.cameras[0], c.x / 64.0 - r, c.y / 64.0 - r, c.x / 64.0 + r, c.y / 64.0 + r);
+}
+
+// bench/scenes.json's caustic region of a bundled scene, seen by a crop of its camera.
+ManifoldView causticRegion(const Scene& scene, double x0, double y0, double x1, double y1, int sppNaive, int sppMis,
+                           int sppManifold) {
+  return {"caustic region", cropCamera(sceneCamera(scene), x0, y0, x1, y1), sppNaive, sppMis, sppManifold};
+}
+
+}  // namespace
+
+// Unbiasedness of manifold NEE at the resolution issue 33 asks for: a 0.5 % bias of the caustic
+// region's mean and of the image mean fails (asserted: the printed resolution <= 0.5 %). The time goes
+// where each estimate is noisier: samples per estimator in proportion to (its standard error per
+// sample) x (its seconds per sample), the split that minimises the total time for a given standard
+// error of the difference.
+//
+// The glass ball under a 60 cm lamp seen only at its focus (the floor within 1 % of the image width
+// of the point under the ball): mis converges there (its reference is not fireflies), and manifold NEE
+// carries 58 % of the focus's mean (measured: with its contribution zeroed the focus drops from 1.785
+// to 0.745). Measured: resolves 0.44 % against mis (0.91 % against naive); scaling manifold NEE's
+// contribution by 1.0086 (a 0.5 % bias of the focus's mean) fails it at 6.9 standard errors.
+TEST_CASE("manifold NEE is unbiased: glass ball focus") {
+  Scene scene = causticScene(0.0f, 0.3f);
+  ManifoldView focus{"caustic region (focus)", causticFocusCamera(scene, 0.01), 2048, 8192, 1536, true};
+  checkManifoldUnbiased("glass ball, 60 cm lamp", scene, focus);
+}
+
+// mirror-caustic's image and bench/scenes.json's caustic region, where manifold NEE carries 8 % and
+// 16 % of the mean (the rest is direct and indirect light). Measured: resolves 0.41 % (image) and
+// 0.40 % (caustic region) against mis. With manifold NEE's whole estimate scaled by 0.995 the means
+// fail at -7.0 and -7.8 standard errors; scaled by 1.005, quadrants fail at 4.6-5.1 (the means, which
+// these seeds put 0.15-0.20 % below mis, at 3.9 and 3.3; other seeds put them +0.09 % and -0.005 %).
+TEST_CASE("manifold NEE is unbiased: mirror-caustic") {
+  Scene scene = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
+  checkManifoldUnbiased("mirror-caustic", scene, {"image", sceneCamera(scene), 2048, 32768, 1408, true});
+  ManifoldView region = causticRegion(scene, 0.30, 0.50, 0.70, 0.85, 2048, 32768, 1280);
+  region.sharp = true;
+  checkManifoldUnbiased("mirror-caustic", scene, region);
+}
+
+// The other scenes at what a few seconds each resolve (printed; CAUSTICA_LONG_TESTS=1 takes 4x). The
+// glass ball's whole image is "manifold NEE matches naive and mis: glass ball caustic"'s.
+TEST_CASE("manifold NEE is unbiased: lamp-caustics") {
+  Scene scene = loadScene(sourcePath("assets/scenes/lamp-caustics.gltf"));
+  checkManifoldUnbiased("lamp-caustics", scene, {"image", sceneCamera(scene), 1024, 1024, 256});
+  checkManifoldUnbiased("lamp-caustics", scene, causticRegion(scene, 0.30, 0.52, 0.68, 0.82, 0, 1024, 256));
+}
+
+TEST_CASE("manifold NEE is unbiased: cornell-glass and cornell-dispersion") {
+  Scene glass = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
+  checkManifoldUnbiased("cornell-glass", glass, causticRegion(glass, 0.14, 0.86, 0.44, 0.96, 1024, 1024, 256));
+  Scene disp = loadScene(sourcePath("assets/scenes/cornell-dispersion.gltf"));
+  checkManifoldUnbiased("cornell-dispersion", disp, causticRegion(disp, 0.30, 0.81, 0.65, 0.94, 1024, 1024, 256));
+}
+
+// Dispersion: manifold NEE joins each sample's wavelength (spectral) or colour channel (rgb) through a
+// ball whose index depends on it; its rainbow-fringed focus against mis and naive in both modes.
+TEST_CASE("manifold NEE is unbiased: dispersion, rgb and spectral") {
+  Scene scene = causticScene(1.0f, 0.3f);
+  ManifoldView focus{"caustic region (dispersed focus)", causticFocusCamera(scene, 0.03), 512, 1024, 256};
+  checkManifoldUnbiased("dispersive glass ball, rgb", scene, focus, DispersionMode::Rgb);
+  checkManifoldUnbiased("dispersive glass ball, spectral", scene, focus, DispersionMode::Spectral);
+}
+
+namespace {
+
+// causticScene kept as meshes and instances: the floor, the lamp and the ball (a unit sphere placed
+// by a rotated, scaled instance).
+Scene instancedCausticScene() {
+  Scene s;
+  s.path = "instanced-caustic";
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(18.0f), glassMaterial(1.5f)};
+  const auto mesh = [&](auto add) { s.instances.push_back({addMesh(s, add), glm::dmat4(1.0)}); };
+  const float h = 0.3f;
+  mesh([&] { addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0); });
+  mesh([&] { addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1); });
+  mesh([&] { addSphere(s, glm::vec3(0.0f), 1.0f, 24, 2); });
+  s.instances.back().world = glm::scale(glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.62, 0.0)),
+                                                    0.7, glm::dvec3(0.3, 1.0, 0.2)),
+                                        glm::dvec3(0.3));
+  finishInstancedBounds(s);
+  s.cameras.push_back(lookAt({0.0f, 1.4f, 1.9f}, {0.0f, 0.0f, 0.0f}, 0.9f));
+  return s;
+}
+
+}  // namespace
+
+// Instanced scenes: manifold NEE in the instanced scene against its flattened copy with the same seeds
+// (the same paths up to rounding: measured 1.2e-5 apart, so a 0.1 % bias of the instanced path fails),
+// and against mis in the instanced scene.
+TEST_CASE("manifold NEE is unbiased: instanced caster") {
+  const Scene inst = instancedCausticScene();
+  Scene flat = inst;
+  flattenInstances(flat);
+  const Camera focus = causticFocusCamera(inst, 0.03);
+  RenderSettings settings = smallSettings(16, 16, Integrator::Mis, 3);
+  settings.manifold = ManifoldMode::On;
+  const RenderResult a = renderScene(inst, focus, settings, 256, 64);
+  const RenderResult b = renderScene(flat, focus, settings, 256, 64);
+  REQUIRE(hasDefine(a.defines, "CAUSTICA_INSTANCED"));
+  REQUIRE_FALSE(hasDefine(b.defines, "CAUSTICA_INSTANCED"));
+  REQUIRE(hasDefine(a.defines, "CAUSTICA_MANIFOLD"));
+  const std::array<double, 5> qa = quadrantMeans(a.image), qb = quadrantMeans(b.image);
+  for (int q = 0; q < 5; ++q) {
+    INFO("region ", q, " (image, then quadrants): instanced ", qa[q], ", flattened ", qb[q]);
+    CHECK(qa[q] == Rel(qb[q], 0.001));
+  }
+  MESSAGE("instanced caster, focus: instanced ", qa[0], " flattened ", qb[0], ": differ by ",
+          100.0 * (qa[0] - qb[0]) / qb[0], " %");
+  checkManifoldUnbiased("instanced glass ball", inst, {"caustic region (focus)", focus, 0, 512, 128});
 }
 
 TEST_CASE("rgb and spectral dispersion agree in mean brightness, and spread the caustic into colours") {

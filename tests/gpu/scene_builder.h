@@ -1,6 +1,6 @@
 // scene_builder.h — how the GL tests build scenes in memory: materials by kind, quads, boxes and UV
-// spheres (counter-clockwise fronts, flat or radial normals), cameras, and the bounds a finished scene
-// needs. World space, scene units; radiance and albedo linear.
+// spheres (counter-clockwise fronts, flat or radial normals), meshes of instanced scenes, cameras, and
+// the bounds a finished scene needs. World space, scene units; radiance and albedo linear.
 #pragma once
 #include <array>
 #include <cmath>
@@ -104,6 +104,27 @@ inline void finishBounds(Scene& s) {
   s.bounds = Bounds{};
   for (const Triangle& t : s.triangles)
     for (const glm::vec3& p : t.p) s.bounds.grow(p);
+}
+
+// Makes the triangles that add() appends one mesh (Scene::meshes) of an instanced scene; returns its index.
+template <class Add>
+std::uint32_t addMesh(Scene& s, Add&& add) {
+  MeshRange r;
+  r.firstTriangle = static_cast<std::uint32_t>(s.triangles.size());
+  add();
+  r.triangleCount = static_cast<std::uint32_t>(s.triangles.size()) - r.firstTriangle;
+  s.meshes.push_back(r);
+  return static_cast<std::uint32_t>(s.meshes.size() - 1);
+}
+
+// Sets an instanced scene's bounds to those of its instances' world-space triangles.
+inline void finishInstancedBounds(Scene& s) {
+  s.bounds = Bounds{};
+  for (const Instance& in : s.instances) {
+    const MeshRange& m = s.meshes[in.mesh];
+    for (std::uint32_t i = m.firstTriangle; i < m.firstTriangle + m.triangleCount; ++i)
+      for (const glm::vec3& p : s.triangles[i].p) s.bounds.grow(glm::vec3(in.world * glm::dvec4(glm::dvec3(p), 1.0)));
+  }
 }
 
 // A camera at `position` looking along `forward` with `up` (both taken as given), vertical field of
