@@ -2,7 +2,6 @@
 #include "accel/manifold_chain.h"
 
 #include <cmath>
-#include <cstdlib>
 
 #include "accel/bvh_wide.h"
 #include "accel/spawn.h"
@@ -167,8 +166,7 @@ bool chainResidual(const ManifoldScene& s, const ManifoldQuery& q, const RayDiff
   // along d from the plane onto the triangle's, times d(ab)/d(omega) = |w|^3 (gnomonic).
   float detJ = std::abs(J[0][0] * J[1][1] - J[1][0] * J[0][1]);
   res.areaPerSolidAngle = detJ * wLen * wLen * wLen * std::abs(dn) / std::abs(glm::dot(r.d, q.nL));
-  static float tol = std::getenv("MTOL") ? float(atof(std::getenv("MTOL"))) : kManifoldTolerance;
-  converged = glm::length(diff) <= tol * glm::length(e);
+  converged = glm::length(diff) <= kManifoldTolerance * glm::length(e);
   return true;
 }
 
@@ -219,14 +217,6 @@ ManifoldResult manifoldSolve(const ManifoldScene& s, const ManifoldQuery& q) {
       if (!(std::abs(det) > 0.0f)) break;
       step = glm::vec2(J[1][1] * F.x - J[1][0] * F.y, -J[0][1] * F.x + J[0][0] * F.y) / det;
       stepScale = 1.0f;
-      if (const char* fs = std::getenv("MFIRST")) if (it == 0) stepScale = float(atof(fs));
-      if (const char* tr = std::getenv("MTRUST")) {  // experiment: trust radius as a fraction of the cone's tangent
-        glm::vec3 dc = glm::vec3(s.casters.sphere[q.caster]) - q.x;
-        float r = s.casters.sphere[q.caster].w, d2 = glm::dot(dc, dc);
-        float tanA = d2 > r * r ? r / std::sqrt(d2 - r * r) : 1.0f;
-        float lim = float(atof(tr)) * tanA, len = glm::length(step);
-        if (len > lim) step *= lim / len;
-      }
       misses = 0;
     } else {
       if (!haveChain || ++misses > 3u) break;
