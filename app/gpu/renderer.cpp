@@ -120,6 +120,9 @@ void Renderer::setScene(const Scene& scene, const Camera& camera) {
   load_ = LoadTimes{};
   camera_ = camera;
   raster_.reset();  // the raster pipeline holds the previous scene's mesh
+  causticCells_ = CausticCells();  // the photon cells are the previous scene's: program() builds the new ones
+  cellTableMask_ = 0;
+  cellCasters_ = 0;
   loadScene(scene);
   const bool transparent = gpuScene_.environmentParams.size.z == gpu::kBackgroundTransparent;
   if (transparent != transparent_) {

@@ -240,8 +240,8 @@ class Renderer {
   ShadingTextures shadingTextures_;  // the shading's views of the materials, light-tree and texture buffers
   GlBuffer frameUbo_;
   GlBuffer casterUbo_;
-  std::uint32_t cellTableMask_ = 0;
-  std::uint32_t cellCasters_ = 0;    // the casters (manifoldCasterMask) the cell table was built for  // CasterParams::count.z: the caustic cell table's bucket mask, once built
+  std::uint32_t cellTableMask_ = 0;  // CasterParams::count.z: the caustic cell table's bucket mask, once built
+  std::uint32_t cellCasters_ = 0;    // the casters (manifoldCasterMask) the cell table was built for
   CausticCells causticCells_;
   std::vector<LightGroup> lightGroups_;
   gpu::PointLights pointLights_{};

@@ -60,3 +60,27 @@ TEST_CASE("resume from a checkpoint: 8 spp + 8 spp equals 16 spp bit for bit") {
     std::filesystem::remove(path);
   }
 }
+
+TEST_CASE("a renderer given a new scene (an animation's next frame) renders what a new renderer does, also with manifold NEE") {
+  // Both scenes have two casters, so the same caster mask: the photon cells must still be the new scene's.
+  const Scene first = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
+  const Scene second = loadScene(sourcePath("assets/scenes/lamp-caustics.gltf"));
+  for (bool manifold : {false, true}) {
+    CAPTURE(manifold);
+    RenderSettings rs = smallSettings(16, 12, Integrator::Mis, 3);
+    rs.manifold = manifold ? ManifoldMode::On : ManifoldMode::Off;
+    ShaderLibrary& library = testShaderLibrary();
+    Renderer fresh(library, second, sceneCamera(second), rs);
+    fresh.renderPass(8);
+    const Image expected = fresh.image();
+
+    Renderer reused(library, first, sceneCamera(first), rs);
+    reused.renderPass(8);
+    reused.setScene(second, sceneCamera(second));
+    reused.renderPass(8);
+    const Image got = reused.image();
+    REQUIRE(got.rgb.size() == expected.rgb.size());
+    CHECK(meanOf(expected) > 0.01);  // not a black image
+    CHECK(differing(got.rgb, expected.rgb) == 0);
+  }
+}
