@@ -113,7 +113,8 @@ void compareSolves(const ManifoldTestScene& t, GlslManifold& gpu, const std::vec
   int okBoth = 0, flips = 0;
   Worst ab{label + ": |ab GLSL - ab C++|"}, end{label + ": C++ chain at the GLSL's ab: |F| / |last vertex - y|"},
       area{label + ": dA/domega at the GLSL's ab, relative"}, thr{label + ": throughput there, relative"},
-      prob{label + ": event probability there, relative"}, lambda{label + ": wavelength and filter, relative"};
+      prob{label + ": event probability there, relative"}, lambda{label + ": wavelength and filter, relative"},
+      dir{label + ": direction w at x there"};
   for (size_t i = 0; i < qs.size(); ++i) {
     ManifoldResult c = manifoldSolve(t.ms, qs[i]);
     bool g = out[i].v[0].x != 0.0f;
@@ -133,6 +134,7 @@ void compareSolves(const ManifoldTestScene& t, GlslManifold& gpu, const std::vec
     REQUIRE(traceManifoldChain(t.ms, qs[i], gab, r, F, J, converged));
     end.add(glm::length(F) / glm::length(glm::dvec3(r.pLast) - glm::dvec3(qs[i].y)));
     area.add(relDiff(out[i].v[1].w, r.areaPerSolidAngle));
+    dir.add(vecDiff(glm::vec3(out[i].v[1]), r.w));
     thr.add(vecRel(glm::vec3(out[i].v[2]), r.throughput));
     prob.add(relDiff(out[i].v[2].w, r.eventProb));
     lambda.add(std::max(relDiff(out[i].v[7].w, c.lambda), vecRel(glm::vec3(out[i].v[7]), c.filt)));
@@ -148,6 +150,7 @@ void compareSolves(const ManifoldTestScene& t, GlslManifold& gpu, const std::vec
   CHECK(flips * 100 <= static_cast<int>(qs.size()));
   ab.check(kManifoldSameSolution);
   end.check(2e-5);
+  dir.check(2e-6);  // measured 1.7e-7: the GLSL's direction at its own ab is the C++'s to float rounding
   area.check(5e-4);
   thr.check(1e-4);
   prob.check(1e-4);
@@ -193,7 +196,9 @@ TEST_CASE("manifold twins: the GLSL chain solve equals its C++ twin on a glass s
   std::vector<Output> out = gpu.run(ManifoldFn::TraceChain, in);
   int traceFlips = 0;
   Worst F{"traceManifoldChain: |F GLSL - F C++| / |last vertex - y|"}, J{"traceManifoldChain: |J GLSL - J C++| / |J|"},
-      area2{"traceManifoldChain: dA/domega, relative"};
+      area2{"traceManifoldChain: dA/domega, relative"}, w2{"traceManifoldChain: direction w at x"},
+      last{"traceManifoldChain: last vertex, relative to the chain's end distance, and last direction"};
+  int convergedFlips = 0;
   for (size_t i = 0; i < traced.size(); ++i) {
     ManifoldResult r;
     r.lambda = traced[i].lambda;
@@ -211,6 +216,10 @@ TEST_CASE("manifold twins: the GLSL chain solve equals its C++ twin on a glass s
     glm::dvec4 gj(out[i].v[4]), cj(cJ[0][0], cJ[0][1], cJ[1][0], cJ[1][1]);
     J.add(glm::length(gj - cj) / glm::length(cj));
     area2.add(relDiff(out[i].v[1].w, r.areaPerSolidAngle));
+    w2.add(vecDiff(glm::vec3(out[i].v[1]), r.w));
+    last.add(std::max(vecDiff(glm::vec3(out[i].v[5]), r.pLast) / std::max(scale, 1e-30),
+                      vecDiff(glm::vec3(out[i].v[6]), r.dLast)));
+    if (conv != (out[i].v[0].y != 0.0f)) ++convergedFlips;
   }
   // Measured: F within 2.6e-6 of the chain's length, J within 4.2e-5, dA/domega within 7.8e-5 (float
   // rounding through two refractions): a 0.5 % error of J or dA/domega in either twin fails.
@@ -218,6 +227,9 @@ TEST_CASE("manifold twins: the GLSL chain solve equals its C++ twin on a glass s
   F.check(2e-5);
   J.check(3e-4);
   area2.check(5e-4);
+  w2.check(2e-6);     // measured 1.7e-7
+  last.check(2e-5);   // measured 2.6e-6: the chain's last vertex and direction, which the shadow ray leaves from
+  CHECK(convergedFlips * 100 <= static_cast<int>(traced.size()));
 }
 
 TEST_CASE("manifold twins: normalDiffOn, transferDiff, refractDiff and reflectDiff equal their C++ twins") {
