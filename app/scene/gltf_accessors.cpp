@@ -163,6 +163,11 @@ const tinygltf::Accessor& SceneBuilder::checkedAccessor(int index, int type, con
 
 // Reads accessor `index` as doubles (count x components), applying normalisation and sparse
 // substitution; `allowed` lists the (componentType, normalized) pairs legal for this use.
+void SceneBuilder::countDecoded(std::uint64_t n) {
+  decoded_ += n;
+  if (decoded_ > kMaxDecoded) fail("the meshes are too large (more than " + str(kMaxDecoded) + " accessor elements)");
+}
+
 std::vector<double> SceneBuilder::readAccessor(int index, int type, const Formats& allowed,
                                                const std::string& use) {
   const tinygltf::Accessor& acc = checkedAccessor(index, type, allowed, use);
@@ -186,8 +191,7 @@ std::vector<double> SceneBuilder::readAccessor(int index, int type, const Format
   } else if (acc.count > kMaxZeroElements) {
     fail(at + ": count " + str(acc.count) + " is too large for an accessor without a bufferView");
   }
-  decoded_ += acc.count;
-  if (decoded_ > kMaxDecoded) fail("the meshes are too large (more than " + str(kMaxDecoded) + " accessor elements)");
+  countDecoded(acc.count);
   std::vector<double> out(acc.count * components, 0.0);  // no bufferView: zeros (glTF 3.6.2.3)
 
   if (acc.bufferView >= 0) {

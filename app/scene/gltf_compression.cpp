@@ -148,8 +148,7 @@ SceneBuilder::DracoPrimitive SceneBuilder::decodeDraco(const tinygltf::Primitive
   if (out.indexed && model_.accessors[std::size_t(prim.indices)].count != faces * 3)
     fail(eat + ": the Draco mesh has " + str(faces) + " triangles, but the indices accessor has " +
          str(model_.accessors[std::size_t(prim.indices)].count) + " indices");
-  decoded_ += faces * 3;
-  if (decoded_ > kMaxDecoded) fail("the meshes are too large (more than " + str(kMaxDecoded) + " accessor elements)");
+  countDecoded(faces * 3);
   out.indices.reserve(std::size_t(faces) * 3);
   for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
     for (int k = 0; k < 3; ++k) {
@@ -177,8 +176,7 @@ SceneBuilder::DracoPrimitive SceneBuilder::decodeDraco(const tinygltf::Primitive
            str(std::uint64_t(std::max(components, 0))));
     if (acc.count != points)
       fail(aat + ": the Draco mesh has " + str(points) + " points, but the accessor's count is " + str(acc.count));
-    decoded_ += points;
-    if (decoded_ > kMaxDecoded) fail("the meshes are too large (more than " + str(kMaxDecoded) + " accessor elements)");
+    countDecoded(points);
     // Draco returns integers as stored unless its attribute is marked normalized; the accessor's
     // normalized flag then applies glTF's rules, as for uncompressed data.
     const bool integral = attribute->data_type() != draco::DT_FLOAT32 && attribute->data_type() != draco::DT_FLOAT64;

@@ -181,6 +181,8 @@ class SceneBuilder {
 
  private:
   [[noreturn]] void fail(const std::string& what) const { throw Error(path_ + ": " + what); }
+  // Counts n more decoded accessor elements (accessors, Draco, meshopt) against kMaxDecoded.
+  void countDecoded(std::uint64_t n);
   void warn(const std::string& what) { scene_.warnings.push_back(path_ + ": " + what); }
 
   void skip(const std::string& what) {
