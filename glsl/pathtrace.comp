@@ -82,7 +82,7 @@ bool pathBounce(inout PathState s) {
   bool nonDelta = isDiffuseLobe(lobe) || isGlossyLobe(lobe);
 #ifdef CAUSTICA_AOV
   // The first non-specular hit, or an emitter (albedo 1: its radiance is not divided by a colour).
-  if (surfaceEmits(sf) || isDiffuseLobe(lobe) || isGlossyLobe(lobe))
+  if (surfaceEmits(sf) || nonDelta)
     featuresRecord(s.feat, surfaceEmits(sf) ? vec3(1.0) : lobe.color, sf.ns, false);
 #endif
 #ifdef CAUSTICA_MANIFOLD
