@@ -36,6 +36,7 @@ int cmdBench(const std::vector<std::string>& args) {
        "256 spp (OUT/denoise.csv, bench-denoise-SCENE.png plots and -pictures.png figures, a summary table; docs/denoising.md)"},
       sceneOptionSpec("--max-depth"),
       sceneOptionSpec("--caster-probability"),
+      sceneOptionSpec("--guide-probability"),
       sceneOptionSpec("--manifold"),
       sceneOptionSpec("--camera"),
       sceneOptionSpec("--backend"),

@@ -36,6 +36,9 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
     m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
     throw Error(m.str());
   }
+  s.guideProbability = static_cast<float>(opts.getDouble("--guide-probability", defaults.guideProbability));
+  if (!(s.guideProbability >= 0.0f && s.guideProbability <= 1.0f))
+    throw Error("option --guide-probability needs a number from 0 to 1");
   s.manifold = parseManifoldMode(opts.get("--manifold", settingText(defaults.manifold)));
   s.allFeatures = opts.has("--all-features");
   s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
