@@ -192,7 +192,9 @@ class Renderer {
   const FeatureSet& sceneFeatures() const { return sceneFeatures_; }
   std::vector<std::string> shaderDefines() const;
   // The caustic cell table of manifold NEE as its photon pass built it (zero before one ran).
-  CausticCellStats causticCellStats() const { return causticCells_.stats(); }
+  CausticCellStats causticCellStats(CellTable t = CellTable::Manifold) const {
+    return (t == CellTable::Guide ? causticGuides_ : causticCells_).stats();
+  }
   // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
   // Binds the scene's storage blocks, UBOs and textures as the compute shaders read them (before each
