@@ -35,7 +35,7 @@ struct BlockStats {
 BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
                       int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth,
                       float casterProbability = 0.5f, std::vector<std::string>* defines = nullptr,
-                      ManifoldMode manifold = ManifoldMode::Off) {
+                      ManifoldMode manifold = ManifoldMode::Off, float guideProbability = 0.5f) {
   BlockStats b;
   b.blocksX = w / block;
   b.blocksY = h / block;
@@ -46,6 +46,7 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
     settings.maxDepth = maxDepth;
     settings.casterProbability = casterProbability;
     settings.manifold = manifold;
+    settings.guideProbability = guideProbability;
     RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     if (defines) *defines = res.defines;
@@ -363,7 +364,8 @@ std::pair<double, double> blockRegion(const BlockStats& s, int bx0, int by0, int
   return {m, v / renders};  // the variance of the mean
 }
 
-// Manifold NEE against naive and against mis without it on `scene`: blocks, image and quadrants
+// Manifold NEE against naive and against mis without it (and without caster guiding: the estimator
+// manifold NEE improves on) on `scene`: blocks, image and quadrants
 // (checkBlocksAgree), and the caustic region [bx0, bx1) x [by0, by1) of blocks within 4.5 standard
 // errors; naiveBlocks: naive's blocks too. Returns the three estimates' BlockStats (naive, mis, manifold).
 std::array<BlockStats, 3> checkManifoldAgrees(const std::string& what, const Scene& scene, int w, int h, int block,
@@ -374,8 +376,8 @@ std::array<BlockStats, 3> checkManifoldAgrees(const std::string& what, const Sce
   std::uint64_t nonFinite = 0;
   std::vector<std::string> misDefines, manifoldDefines;
   BlockStats naive = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 700, &nonFinite, 32);
-  BlockStats mis =
-      blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 800, &nonFinite, 32, 0.5f, &misDefines);
+  BlockStats mis = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 800, &nonFinite, 32, 0.5f,
+                              &misDefines, ManifoldMode::Off, 0.0f);
   BlockStats manifold = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 900, &nonFinite, 32, 0.5f,
                                    &manifoldDefines, ManifoldMode::On);
   REQUIRE_FALSE(hasDefine(misDefines, "CAUSTICA_MANIFOLD"));
