@@ -9,7 +9,6 @@
 
 #include "cli/checkpoint.h"
 #include "gl_test_util.h"
-#include "scene_builder.h"
 #include "util/error.h"
 
 using namespace caustica;
@@ -163,16 +162,7 @@ TEST_CASE("resume from a checkpoint: one of --manifold off does not continue aut
   }
   // A glass ball far under a small lamp qualifies, a mirror ball beside it does not: auto sends photons
   // through the glass only, an image neither on nor off renders, so it stays "auto".
-  Scene s;
-  Material mirror = diffuseMaterial(0.9f);
-  mirror.metallic = 1.0f;
-  s.materials = {diffuseMaterial(0.8f), emitterMaterial(60.0f), glassMaterial(1.5f), mirror};
-  addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);
-  const float h = 0.08f;
-  addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);
-  addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
-  addSphere(s, {0.5f, 2.0f, 0.0f}, 0.15f, 16, 3);
-  finishBounds(s);
+  const Scene s = lampOverGlassAndMirror();
   const GpuScene g = packScene(s, buildBvh(s.triangles));
   REQUIRE(g.casters.size() == 2);
   CHECK(cli::imageManifoldMode(ManifoldMode::Auto, g) == ManifoldMode::Auto);
