@@ -13,6 +13,18 @@ namespace {
 constexpr double kPiD = 3.14159265358979323846;
 constexpr int kBuckets = 12;
 
+// The build depends only on the emitters' geometry up to scale and translation, not on rounding: a scene
+// scaled or moved gets its vertices, so its centroids, extents and normals, rounded differently (about
+// 1e-7 of its coordinates; normals of a small lamp's coplanar triangles come out 1e-5 apart), and its
+// items arrive in another (BVH) order. So the items are taken in their source order and every partition
+// keeps it; a centroid's place along an axis is taken relative to the node's centroid bounds and snapped
+// to kSnap, so that a centroid on a bucket boundary (symmetric emitters) stays on its side; two costs,
+// or two extents, within kTie of each other are a tie, which the first candidate (axis x before y
+// before z, lower bucket first) wins; and nearly parallel normals widen a cone rather than open it to
+// the whole sphere (unionCone).
+constexpr double kSnap = 65536.0;  // 2^16 steps over the centroid bounds (rounding moves a centroid ~1e-6)
+constexpr double kTie = 1e-3;      // relative: above the rounding noise of costs (1e-5..1e-4 on small triangles)
+
 // Bounds of a set of emitters: box, power, and the cone of normals (axis, half angle theta_o) beyond
 // which light leaves within theta_e (pi/2 for every triangle: cosine emission).
 struct Bounds {
@@ -47,8 +59,14 @@ void unionCone(glm::dvec3& axis, double& theta, const glm::dvec3& axisB, double 
   }
   double thetaNew = (theta + d + thetaB) / 2.0 + 1e-5;
   glm::dvec3 rotAxis = glm::cross(axis, axisB);
-  if (thetaNew >= kPiD || glm::dot(rotAxis, rotAxis) < 1e-24) {
+  if (thetaNew >= kPiD) {
     theta = kPiD;  // the whole sphere
+    return;
+  }
+  if (glm::dot(rotAxis, rotAxis) < 1e-24) {
+    // Axes too nearly parallel to rotate between: keep this axis, widened to hold the other cone
+    // (nearly opposite axes: the whole sphere). Rounding leaves coplanar triangles' normals this close.
+    theta = d < kPiD / 2.0 ? std::min(std::max(theta, d + thetaB) + 1e-5, kPiD) : kPiD;
     return;
   }
   rotAxis = glm::normalize(rotAxis);
@@ -125,7 +143,7 @@ class Builder {
   }
 
  private:
-  // Returns the first item of the right child; both sides non-empty.
+  // Returns the first item of the right child; both sides non-empty. Keeps the items' order on each side.
   std::size_t split(std::vector<Item>& items, std::size_t begin, std::size_t end, const Bounds& b, int depth) {
     std::size_t n = end - begin;
     glm::dvec3 cLo(1e300), cHi(-1e300);
@@ -149,7 +167,7 @@ class Builder {
         for (int k = s + 1; k < kBuckets; ++k) grow(r, bucket[k]);
         if (l.empty() || r.empty()) continue;
         double cost = splitCost(l, kr) + splitCost(r, kr);
-        if (cost < bestCost) {
+        if (cost < bestCost * (1.0 - kTie)) {
           bestCost = cost;
           bestAxis = a;
           bestBucket = s;
@@ -159,27 +177,37 @@ class Builder {
     std::size_t mid = begin;
     if (bestAxis >= 0) {
       double lo = cLo[bestAxis], hi = cHi[bestAxis];
-      auto it = std::partition(items.begin() + static_cast<std::ptrdiff_t>(begin), items.begin() + static_cast<std::ptrdiff_t>(end),
-                               [&](const Item& it2) { return bucketOf(it2.centroid[bestAxis], lo, hi) <= bestBucket; });
+      auto it = std::stable_partition(items.begin() + static_cast<std::ptrdiff_t>(begin),
+                                      items.begin() + static_cast<std::ptrdiff_t>(end),
+                                      [&](const Item& it2) { return bucketOf(it2.centroid[bestAxis], lo, hi) <= bestBucket; });
       mid = static_cast<std::size_t>(it - items.begin());
     }
     // Depth guard: every leaf below must stay within the trail's bits. A side with m items needs
-    // ceil(log2 m) more levels at least; if the best split leaves too few, halve by count instead.
+    // ceil(log2 m) more levels at least; if the best split leaves too few, halve by count instead,
+    // along the widest axis, in the order of the snapped centroids (ties: the items' order).
     auto levels = [](std::size_t m) { int l = 0; while ((std::size_t(1) << l) < m) ++l; return l; };
     int budget = CAUSTICA_LIGHT_TREE_DEPTH - (depth + 1);
     if (mid == begin || mid == end || levels(mid - begin) > budget || levels(end - mid) > budget) {
-      int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+      int axis = 0;
+      for (int a = 1; a < 3; ++a)
+        if (ext[a] > ext[axis] * (1.0 + kTie)) axis = a;
       mid = begin + n / 2;
-      std::nth_element(items.begin() + static_cast<std::ptrdiff_t>(begin), items.begin() + static_cast<std::ptrdiff_t>(mid),
-                       items.begin() + static_cast<std::ptrdiff_t>(end),
-                       [axis](const Item& x, const Item& y) { return x.centroid[axis] < y.centroid[axis]; });
+      const double lo = cLo[axis], hi = cHi[axis];
+      std::stable_sort(items.begin() + static_cast<std::ptrdiff_t>(begin), items.begin() + static_cast<std::ptrdiff_t>(end),
+                       [&](const Item& x, const Item& y) {
+                         return snapped(x.centroid[axis], lo, hi) < snapped(y.centroid[axis], lo, hi);
+                       });
     }
     return mid;
   }
 
+  // A centroid's place in [lo, hi] as a fraction, snapped to 1/kSnap (0 where lo == hi).
+  static double snapped(double c, double lo, double hi) {
+    if (!(hi > lo)) return 0.0;
+    return std::round(std::clamp((c - lo) / (hi - lo), 0.0, 1.0) * kSnap) / kSnap;
+  }
   static int bucketOf(double c, double lo, double hi) {
-    int k = static_cast<int>(kBuckets * (c - lo) / (hi - lo));
-    return std::clamp(k, 0, kBuckets - 1);
+    return std::min(static_cast<int>(kBuckets * snapped(c, lo, hi)), kBuckets - 1);
   }
 
   LightTree& tree_;
@@ -225,6 +253,8 @@ LightTree buildLightTree(std::vector<LightTreeItem> in, std::size_t triangleCoun
       throw Error("light_tree.cpp: more than 2^30 instances");
     items.push_back(it);
   }
+  // The source order, not the caller's (a BVH's, which rounding can change): partitions keep it.
+  std::stable_sort(items.begin(), items.end(), [](const Item& x, const Item& y) { return x.source < y.source; });
   tree.nodes.reserve(2 * items.size());
   tree.nodes.resize(1);
   Builder builder(tree);

@@ -27,13 +27,15 @@ struct LightTree {
   std::vector<std::uint32_t> leafOf;  // per triangle (TriGeom order): its leaf node, or kInvalidIndex
   int maxDepth = 0;                   // deepest leaf (root = 0); at most CAUSTICA_LIGHT_TREE_DEPTH
   // Every leaf, in the order of its item's `source`: an order that scaling or moving the scene keeps
-  // (the tree's own order can change with rounding; the caustic photon pass, caustic_cells.h).
+  // (the caustic photon pass, caustic_cells.h).
   std::vector<std::uint32_t> leavesBySource;
 };
 
 // Builds the tree: binary splits in 12 buckets per axis minimising power x orientation measure x
 // surface area (Conty Estevez & Kulla's cost), falling back to splits by count where a leaf could get
 // deeper than CAUSTICA_LIGHT_TREE_DEPTH. `triangleCount`: size of leafOf. Empty items: empty tree.
+// The tree depends on the items' geometry up to scale and translation and on their `source` order,
+// not on the order they are given in nor on the rounding of scaled or moved vertices (light_tree.cpp).
 LightTree buildLightTree(std::vector<LightTreeItem> items, std::size_t triangleCount);
 
 // ---- C++ twins of glsl/lib/light_tree.glsl (same names, same float arithmetic) ----

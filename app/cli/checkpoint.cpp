@@ -178,4 +178,12 @@ std::string checkpointMismatch(const Checkpoint& ck, std::uint64_t sceneHash, co
   return out;
 }
 
+std::string checkpointMismatch(const Checkpoint& ck, std::uint64_t sceneHash, const std::string& identity,
+                               const GpuScene* gpu) {
+  Checkpoint resolved;
+  resolved.sceneHash = ck.sceneHash;
+  resolved.identity = gpu ? resolveIdentityManifold(ck.identity, *gpu) : identityWithoutManifold(ck.identity);
+  return checkpointMismatch(resolved, sceneHash, gpu ? resolveIdentityManifold(identity, *gpu) : identityWithoutManifold(identity));
+}
+
 }  // namespace caustica::cli

@@ -156,8 +156,8 @@ int renderFrames(const Options& opts, const std::string& pattern, const RenderBu
     const double uploadSeconds = renderer->loadTimes().ready;
     const std::string out = frameFileName(pattern, n);
     const std::string checkpointFile = out + ".ckpt";
-    const auto saveCheckpoint =
-        checkpointWriter(*renderer, checkpointFile, sceneHash, accumulationIdentity(ls.settings, ls.camera), std::nullopt);
+    const auto saveCheckpoint = checkpointWriter(*renderer, checkpointFile, sceneHash,
+                                                 accumulationIdentity(ls.settings, ls.camera, renderer->gpuScene()), std::nullopt);
     const BudgetResult result = renderWithBudget(*renderer, budget, "frame " + std::to_string(n), quiet,
                                                  renderHooks(checkpointSeconds, saveCheckpoint));
     writeOutput(*renderer, out, ls.settings.tone, denoise, aovs, quiet || n != first);
@@ -304,10 +304,11 @@ void checkSceneForOutput(const LoadedScene& ls, const std::string& out, bool fea
                 renderModeName(ls.settings.render.mode));
 }
 
-// Refuses a checkpoint of another scene, other settings or another shard.
+// Refuses a checkpoint of another scene, other settings or another shard. Called before the scene is
+// packed (gpu null: every setting but --manifold, whose image depends on the scene) and again after.
 void checkResumable(const Checkpoint& from, const std::string& resumePath, std::uint64_t sceneHash,
-                    const std::string& identity, const std::optional<SampleShare>& share) {
-  std::string diff = checkpointMismatch(from, sceneHash, identity);
+                    const std::string& identity, const std::optional<SampleShare>& share, const GpuScene* gpu) {
+  std::string diff = checkpointMismatch(from, sceneHash, identity, gpu);
   if (!diff.empty()) throw Error(resumePath + ": cannot resume another render: " + diff);
   if (from.shard && !share)
     throw Error(resumePath + ": it is the partial of " + describeShare(*from.shard) + " of " +
@@ -427,12 +428,12 @@ int cmdRender(const std::vector<std::string>& args) {
   const ToneMapSettings& tone = ls.settings.tone;
   flattenForMode(ls.scene, settings.mode, opts, quiet);  // raster draws flat scenes (cli_common.h)
   const std::uint64_t sceneHash = hashSceneFiles(ls.scene.path);
-  const std::string identity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
+  const std::string givenIdentity = accumulationIdentity(ls.settings, ls.camera);  // image_settings.h
   note(quiet, "settings: " + settingsSummary(ls.settings));
   if (share && renderModeSpec(settings.mode).samples == SampleRule::OneFrame)
     throw Error(std::string("--mode ") + renderModeName(settings.mode) +
                 " with --shard: it draws one deterministic frame, there are no samples to share");
-  if (resumeFrom) checkResumable(*resumeFrom, resumePath, sceneHash, identity, share);
+  if (resumeFrom) checkResumable(*resumeFrom, resumePath, sceneHash, givenIdentity, share, nullptr);
   std::string glInfo;
   auto context = createHeadlessContext(backend, &glInfo);
   memTrace("context");
@@ -441,6 +442,9 @@ int cmdRender(const std::vector<std::string>& args) {
   const double startToRenderer = std::chrono::duration<double>(std::chrono::steady_clock::now() - commandStart).count();
   Renderer renderer(library, ls.scene, ls.camera, settings);
   renderer.setFeatureBuffers(features);
+  // What this render records: --manifold as the image of this scene sees it (auto resolved).
+  const std::string identity = accumulationIdentity(ls.settings, ls.camera, renderer.gpuScene());
+  if (resumeFrom) checkResumable(*resumeFrom, resumePath, sceneHash, identity, share, &renderer.gpuScene());
   note(quiet, renderSummary(renderer, ls.scene, settings, spp, share));
   if (resumeFrom) {
     renderer.restoreAccumulation(resumeFrom->state);

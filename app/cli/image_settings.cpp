@@ -9,6 +9,7 @@
 
 #include "cli/cli_common.h"
 #include "cli/environment_options.h"
+#include "gpu/shader_features.h"
 #include "scene/punctual_lights.h"
 #include "util/error.h"
 
@@ -130,6 +131,55 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& c)
     t += ' ' + settingText(v);
   if (c.orthographic()) t += " orthographic " + settingText(c.orthoHeight);  // (pinhole identities as before)
   return t + '\n';
+}
+
+ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu) {
+  if (mode != ManifoldMode::Auto) return mode;
+  const std::uint32_t casters = manifoldCasterMask(ManifoldMode::Auto, gpu);
+  if (casters == 0) return ManifoldMode::Off;
+  return casters == manifoldCasterMask(ManifoldMode::On, gpu) ? ManifoldMode::On : ManifoldMode::Auto;
+}
+
+namespace {
+
+// `identity` with its "manifold MODE" line given to `edit`, which returns the line's replacement
+// ("" drops it); a text without that line comes back unchanged.
+template <class Edit>
+std::string editManifoldLine(const std::string& identity, Edit&& edit) {
+  static const std::string key = "manifold ";
+  std::string out;
+  std::istringstream in(identity);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, key.size(), key) == 0) line = edit(line.substr(key.size()));
+    else line += '\n';
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu) {
+  return editManifoldLine(identity, [&](const std::string& mode) {
+    ManifoldMode m;
+    try {
+      m = parseManifoldMode(mode);
+    } catch (const Error&) {
+      return "manifold " + mode + "\n";  // not a mode this build knows: compared as it is (and differs)
+    }
+    return std::string("manifold ") + manifoldModeName(imageManifoldMode(m, gpu)) + "\n";
+  });
+}
+
+std::string identityWithoutManifold(const std::string& identity) {
+  return editManifoldLine(identity, [](const std::string&) { return std::string(); });
+}
+
+std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu) {
+  ImageSettings s = settings;
+  s.render.manifold = imageManifoldMode(s.render.manifold, gpu);
+  return accumulationIdentity(s, camera);
 }
 
 std::string identityDifference(const std::string& a, const std::string& b, const std::string& labelA,

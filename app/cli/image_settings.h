@@ -7,6 +7,7 @@
 #include <string>
 #include <type_traits>
 
+#include "accel/gpu_scene.h"
 #include "gpu/render_settings.h"
 #include "image/tonemap.h"
 #include "scene/scene.h"
@@ -100,6 +101,23 @@ std::string settingsSummary(const ImageSettings& settings);
 // identities are equal; Speed and Output fields may differ. It is the text stored in a checkpoint
 // (cli/checkpoint.h); compare two with identityDifference.
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera);
+// The accumulation identity of a render of the scene packed as `gpu` (Renderer::gpuScene): as above,
+// with the manifold line as the image sees it (imageManifoldMode). What checkpoints and shard partials
+// record and resuming compares, so that `--manifold auto` on a scene where auto finds no caster
+// continues a `--manifold off` render and the other way round.
+std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu);
+// The manifold mode that decides the image of the scene packed as `gpu`: Auto becomes Off where it
+// sends photons to no caster (resolveManifold: the off variant), On where it takes every caster On
+// takes (the same variant and photon cells), and stays Auto where it takes some casters only (an image
+// neither On nor Off renders). On and Off stay as given.
+ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
+// An identity text with its manifold line replaced by imageManifoldMode for `gpu` (a text without one
+// is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
+// "manifold auto" literally reads as what auto gives for the scene.
+std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
+// The identity text without its manifold line: what can be compared before the scene is packed.
+std::string identityWithoutManifold(const std::string& identity);
+
 // What differs between two identity texts, "key: LABEL-A a, LABEL-B b; ..." (a key missing on one
 // side shows "(none)"); "" when they are equal. E.g. labels "checkpoint" and "this render".
 std::string identityDifference(const std::string& a, const std::string& b, const std::string& labelA,

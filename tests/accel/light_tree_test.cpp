@@ -1,10 +1,16 @@
 // light_tree_test.cpp — the light tree (app/accel/light_tree.h): its choice probabilities over all
 // triangles sum to 1 from any shading point, sampled frequencies match lightTreePdf (chi-square), a
-// triangle it never picks cannot light the point (no bias), and leaves stay within the trail's bits.
+// triangle it never picks cannot light the point (no bias), leaves stay within the trail's bits, and
+// the tree is the same for the emitters scaled, moved and given in another order.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "accel/light_tree.h"
 
@@ -202,4 +208,121 @@ TEST_CASE("light tree: leaves stay within the 32-bit trail on a geometric progre
   glm::vec3 p(3.0f, 1.0f, 0.5f);
   for (std::uint32_t i = 0; i < 200; ++i) sum += lightTreePdf(t.nodes, p, glm::vec3(0, 1, 0), t.leafOf[i]);
   CHECK(std::abs(sum + deadEndMass(t.nodes, p, glm::vec3(0, 1, 0)) - 1.0) <= 1e-4);
+}
+
+namespace {
+
+// Small symmetric lamps as a scene has them: a 16-triangle fan (a disc lamp, 2 cm), a 4x4 grid of
+// quads (a 4-cm panel) tilted and another axis-aligned, a strip of LEDs and a ring of 12 small squares,
+// with a few random emitters around; in double in their own frame, then placed by `world` and rounded
+// to float as a loader does. `source` is the triangle's place in the scene, `tri` its place in `order` (a BVH's).
+std::vector<LightTreeItem> lampScene(const glm::dmat4& world, const std::vector<std::uint32_t>& order) {
+  std::vector<std::array<glm::dvec3, 3>> tris;
+  const glm::dmat4 tilt = glm::rotate(glm::dmat4(1.0), 0.3, glm::dvec3(1.0, 0.2, 0.5));
+  auto add = [&](const glm::dmat4& frame, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+    tris.push_back({glm::dvec3(frame * glm::dvec4(a, 1.0)), glm::dvec3(frame * glm::dvec4(b, 1.0)),
+                    glm::dvec3(frame * glm::dvec4(c, 1.0))});
+  };
+  const glm::dmat4 disc = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.9, 0.1)) * tilt;
+  for (int i = 0; i < 16; ++i) {
+    const double a0 = 2.0 * 3.14159265358979 * i / 16, a1 = 2.0 * 3.14159265358979 * (i + 1) / 16;
+    add(disc, glm::dvec3(0.0), glm::dvec3(0.01 * std::cos(a1), 0.0, 0.01 * std::sin(a1)),
+        glm::dvec3(0.01 * std::cos(a0), 0.0, 0.01 * std::sin(a0)));
+  }
+  const glm::dmat4 panel = glm::translate(glm::dmat4(1.0), glm::dvec3(0.25, 1.1, -0.2)) * tilt;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const double x = -0.02 + 0.01 * i, z = -0.02 + 0.01 * j;
+      add(panel, glm::dvec3(x, 0, z), glm::dvec3(x, 0, z + 0.01), glm::dvec3(x + 0.01, 0, z + 0.01));
+      add(panel, glm::dvec3(x, 0, z), glm::dvec3(x + 0.01, 0, z + 0.01), glm::dvec3(x + 0.01, 0, z));
+    }
+  // An axis-aligned panel: its x and z splits cost the same, and its centroids lie on bucket boundaries.
+  const glm::dmat4 square = glm::translate(glm::dmat4(1.0), glm::dvec3(0.137, 1.213, -0.311));
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const double x = -0.02 + 0.01 * i, z = -0.02 + 0.01 * j;
+      add(square, glm::dvec3(x, 0, z), glm::dvec3(x, 0, z + 0.01), glm::dvec3(x + 0.01, 0, z + 0.01));
+      add(square, glm::dvec3(x, 0, z), glm::dvec3(x + 0.01, 0, z + 0.01), glm::dvec3(x + 0.01, 0, z));
+    }
+  // A strip of 13 LEDs 1 cm apart: their centroids lie on the 12 buckets' boundaries.
+  for (int i = 0; i < 13; ++i) {
+    const glm::dmat4 f = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.271 + 0.01 * i, 0.917, 0.333));
+    add(f, glm::dvec3(-0.002, 0, -0.002), glm::dvec3(-0.002, 0, 0.002), glm::dvec3(0.002, 0, 0.002));
+    add(f, glm::dvec3(-0.002, 0, -0.002), glm::dvec3(0.002, 0, 0.002), glm::dvec3(0.002, 0, -0.002));
+  }
+  const glm::dmat4 ring = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 1.3, 0.4));
+  for (int i = 0; i < 12; ++i) {
+    const glm::dmat4 f = ring * glm::rotate(glm::dmat4(1.0), 2.0 * 3.14159265358979 * i / 12, glm::dvec3(0, 1, 0)) *
+                         glm::translate(glm::dmat4(1.0), glm::dvec3(0.05, 0.0, 0.0));
+    add(f, glm::dvec3(-0.004, 0, -0.004), glm::dvec3(-0.004, 0, 0.004), glm::dvec3(0.004, 0, 0.004));
+    add(f, glm::dvec3(-0.004, 0, -0.004), glm::dvec3(0.004, 0, 0.004), glm::dvec3(0.004, 0, -0.004));
+  }
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> pos(-1.0, 1.0), off(-0.05, 0.05);
+  for (int i = 0; i < 20; ++i) {
+    const glm::dvec3 c(pos(rng), pos(rng) + 1.0, pos(rng));
+    tris.push_back({c + glm::dvec3(off(rng), off(rng), off(rng)), c + glm::dvec3(off(rng), off(rng), off(rng)),
+                    c + glm::dvec3(off(rng), off(rng), off(rng))});
+  }
+  std::vector<LightTreeItem> items(tris.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    LightTreeItem& t = items[k];
+    t.tri = static_cast<std::uint32_t>(k);
+    t.source = order[k];
+    for (int v = 0; v < 3; ++v) t.v[v] = glm::vec3(world * glm::dvec4(tris[order[k]][v], 1.0));
+    glm::dvec3 e1 = tris[order[k]][1] - tris[order[k]][0], e2 = tris[order[k]][2] - tris[order[k]][0];
+    t.power = 0.5 * glm::length(glm::cross(e1, e2)) * 1e4 * (order[k] < 16 ? 3.0 : 1.0);  // area x radiance, unscaled
+  }
+  return items;
+}
+
+// The tree's shape: each node's kind, and for a leaf the source of its emitter, its depth and trail.
+std::vector<std::string> treeShape(const LightTree& t, const std::vector<LightTreeItem>& items) {
+  std::vector<std::uint32_t> sourceOf(items.size());
+  for (const auto& it : items) sourceOf[it.tri] = it.source;
+  std::vector<std::string> shape;
+  for (const gpu::LightNode& n : t.nodes)
+    shape.push_back((n.link.y & gpu::kLightNodeLeaf) ? "leaf " + std::to_string(sourceOf[n.link.x]) + " depth " +
+                                                           std::to_string(n.link.w) + " trail " + std::to_string(n.link.z)
+                                                     : std::string("inner"));
+  return shape;
+}
+
+}  // namespace
+
+TEST_CASE("light tree: the same tree for the emitters scaled by 1e-4..1e4, moved, and given in another order") {
+  // Each rule of the builder's scale invariance (light_tree.cpp) is needed here: without the source
+  // order, the snapped centroids, the cost tie or the cone of nearly parallel normals some tree differs.
+  constexpr std::size_t kTris = 16 + 32 + 32 + 26 + 24 + 20;
+  std::vector<std::uint32_t> identity(kTris);
+  for (std::uint32_t i = 0; i < kTris; ++i) identity[i] = i;
+  const auto refItems = lampScene(glm::dmat4(1.0), identity);
+  const LightTree ref = buildLightTree(refItems, kTris);
+  const std::vector<std::string> refShape = treeShape(ref, refItems);
+  std::mt19937 rng(11);
+  for (double scale : {1e-4, 1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0, 1e2, 1e3, 1e4})
+    for (double move : {0.0, 0.7, 3.0}) {
+      std::vector<std::uint32_t> order = identity;
+      std::shuffle(order.begin(), order.end(), rng);  // the BVH's order changes with rounding
+      const glm::dmat4 world = glm::scale(glm::translate(glm::dmat4(1.0), move * scale * glm::dvec3(1.0, -0.7, 0.4)),
+                                          glm::dvec3(scale));
+      auto items = lampScene(world, order);
+      for (auto& it : items) it.power *= scale * scale;
+      const LightTree t = buildLightTree(items, kTris);
+      CAPTURE(scale);
+      CAPTURE(move);
+      const std::vector<std::string> shape = treeShape(t, items);
+      REQUIRE(shape.size() == refShape.size());
+      int differ = 0;
+      for (std::size_t i = 0; i < shape.size(); ++i) {
+        differ += shape[i] != refShape[i];
+      }
+      CHECK(differ == 0);
+      // The bounds scale with the scene; the cones and relative powers are the same up to rounding.
+      for (std::size_t i = 0; i < shape.size(); ++i) {
+        CHECK(t.nodes[i].boundsMax.w == doctest::Approx(ref.nodes[i].boundsMax.w).epsilon(1e-4));
+        CHECK(glm::dot(glm::vec3(t.nodes[i].axis), glm::vec3(ref.nodes[i].axis)) > 0.9999f);
+        CHECK(t.nodes[i].boundsMin.w / float(scale * scale) == doctest::Approx(ref.nodes[i].boundsMin.w).epsilon(1e-5));
+      }
+    }
 }

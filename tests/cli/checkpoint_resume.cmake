@@ -1,6 +1,7 @@
 # checkpoint_resume.cmake — render 8 spp with --checkpoint, resume to 16 spp and compare with a straight
-# 16-spp render bit for bit (also with other speed and output settings); resuming with another seed,
-# size, background, environment, light radius or scene must fail naming what differs
+# 16-spp render bit for bit (also with other speed and output settings, and with --manifold auto and off
+# where they render the same image); resuming with another seed, size, background, environment, light
+# radius, manifold mode or scene must fail naming what differs
 # (run with cmake -P; CLI, COMPARE (viewer_image_compare) and DIR given).
 file(REMOVE_RECURSE ${DIR})
 file(MAKE_DIRECTORY ${DIR})
@@ -48,6 +49,30 @@ refused("env: checkpoint auto, this render 0.5; env-strength: checkpoint 1, this
         ${COMMON} --env 0.5 --env-strength 2 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
 refused("light-radius: checkpoint 0, this render 0.05"
         ${COMMON} --light-radius 0.05 --spp 16 -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
+# --manifold is recorded as the image sees it: on cornell-box (no caster) auto renders what off does, so
+# a checkpoint of the default auto continues with --manifold off and one of off with auto, to the same
+# bits; on is another image there (the manifold variant) and is refused naming both. On lamp-caustics
+# auto finds casters: a checkpoint of off (an older build's default) does not continue with auto.
+file(READ ${DIR}/half.exr.ckpt head LIMIT 2000)
+if(NOT head MATCHES "\nmanifold off\n")
+  message(FATAL_ERROR "the checkpoint of --manifold auto on a scene without casters does not record what auto resolved to (off)")
+endif()
+run(0 ${COMMON} --spp 16 --manifold off -o ${DIR}/resumed-off.exr --resume ${DIR}/half.exr.ckpt)
+file(SHA256 ${DIR}/resumed-off.exr d)
+if(NOT d STREQUAL b)
+  message(FATAL_ERROR "a checkpoint of --manifold auto on a scene without casters resumed with --manifold off differs from the straight render")
+endif()
+run(0 ${COMMON} --spp 8 --manifold off -o ${DIR}/half-off.exr --checkpoint 1000)
+run(0 ${COMMON} --spp 16 -o ${DIR}/resumed-auto.exr --resume ${DIR}/half-off.exr.ckpt)
+file(SHA256 ${DIR}/resumed-auto.exr e)
+if(NOT e STREQUAL b)
+  message(FATAL_ERROR "a checkpoint of --manifold off resumed with the default auto differs from the straight render")
+endif()
+refused("half.exr.ckpt: cannot resume another render: manifold: checkpoint off, this render on"
+        ${COMMON} --spp 16 --manifold on -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
+run(0 lamp-caustics --size 16 --backend osmesa -q --spp 2 --manifold off -o ${DIR}/lamp-off.exr --checkpoint 1000)
+refused("lamp-off.exr.ckpt: cannot resume another render: manifold: checkpoint off, this render on"
+        lamp-caustics --size 16 --backend osmesa -q --spp 4 -o ${DIR}/x.exr --resume ${DIR}/lamp-off.exr.ckpt)
 if(EXISTS ${DIR}/x.exr)
   message(FATAL_ERROR "a refused resume wrote an image")
 endif()

@@ -37,6 +37,15 @@ merge_run(0 ${DIR}/p3.ckpt ${DIR}/p1.ckpt ${DIR}/p2.ckpt -o ${DIR}/merged.exr)
 same(${DIR}/merged.exr ${DIR}/one.exr)
 merge_run(0 ${DIR}/p1.ckpt ${DIR}/p2.ckpt ${DIR}/p3.ckpt -o ${DIR}/merged.png)
 
+# Partials record --manifold as the image sees it: on cornell-box (no caster) a shard of --manifold off
+# merges with shards of the default auto; one of --manifold on (another image there) is refused.
+run(0 ${COMMON} --spp 10 --shard 2/3 --manifold off -o ${DIR}/p2-off.ckpt)
+merge_run(0 ${DIR}/p1.ckpt ${DIR}/p2-off.ckpt ${DIR}/p3.ckpt -o ${DIR}/merged-off.exr)
+same(${DIR}/merged-off.exr ${DIR}/one.exr)
+run(0 ${COMMON} --spp 10 --shard 2/3 --manifold on -o ${DIR}/p2-on.ckpt)
+merge_refused("are renders with other settings: manifold: .*p1.ckpt off, .*p2-on.ckpt on"
+              ${DIR}/p1.ckpt ${DIR}/p2-on.ckpt ${DIR}/p3.ckpt -o ${DIR}/x.exr)
+
 # A merged .ckpt is a whole render's checkpoint: render --resume takes it to more samples.
 merge_run(0 ${DIR}/p1.ckpt ${DIR}/p2.ckpt ${DIR}/p3.ckpt -o ${DIR}/merged.ckpt)
 run(0 ${COMMON} --spp 14 -o ${DIR}/extended.exr --resume ${DIR}/merged.ckpt)

@@ -452,17 +452,7 @@ TEST_CASE("manifold auto: through the qualifying casters only, it matches mis wi
   // beside the lamp (0.04 sr: does not): auto sends photons through the glass ball only, and the
   // bounce through the mirror keeps weight 1 (no cells of its caster). Any mismatch between the two
   // MIS sides (a weight for paths manifold NEE cannot make through the mirror) shows as a bias.
-  Scene s;
-  Material mirror = diffuseMaterial(0.9f);
-  mirror.metallic = 1.0f;
-  s.materials = {diffuseMaterial(0.8f), emitterMaterial(60.0f), glassMaterial(1.5f), mirror};
-  addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);
-  const float h = 0.08f;
-  addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);
-  addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
-  addSphere(s, {0.5f, 2.0f, 0.0f}, 0.15f, 16, 3);
-  finishBounds(s);
-  s.cameras.push_back(lookAt({0.0f, 1.4f, 1.9f}, {0.0f, 0.0f, 0.0f}, 0.9f));
+  const Scene s = lampOverGlassAndMirror();
   const GpuScene g = packScene(s, buildBvh(s.triangles));
   REQUIRE(g.casters.size() == 2);
   CHECK(manifoldCasterMask(ManifoldMode::Auto, g) != 0u);

@@ -1,6 +1,7 @@
 // resume_test.cpp — a render saved to a checkpoint file at 8 spp and resumed to 16 spp in a new
 // renderer must equal a straight 16-spp render (render --checkpoint / --resume), also with manifold NEE
-// (whose caustic photon pass each renderer runs again: the same cells, so the same image).
+// (whose caustic photon pass each renderer runs again: the same cells, so the same image); the identity
+// records --manifold as the image sees it, so auto and off continue each other where auto finds no caster.
 #include <doctest/doctest.h>
 
 #include <cstring>
@@ -83,4 +84,91 @@ TEST_CASE("a renderer given a new scene (an animation's next frame) renders what
     CHECK(meanOf(expected) > 0.01);  // not a black image
     CHECK(differing(got.rgb, expected.rgb) == 0);
   }
+}
+
+TEST_CASE("resume from a checkpoint: the identity holds --manifold as the image sees it; auto continues off bit for bit where it finds no caster") {
+  // cornell-glass: two casters, but its large ceiling lamp puts neither under auto, so auto renders
+  // the off variant; on (manifold NEE through both) is another image.
+  Scene scene = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
+  Camera camera = sceneCamera(scene);
+  ShaderLibrary& library = testShaderLibrary();
+  RenderSettings autoRs = smallSettings(16, 12, Integrator::Mis, 5), offRs = autoRs, onRs = autoRs;
+  autoRs.manifold = ManifoldMode::Auto;
+  offRs.manifold = ManifoldMode::Off;
+  onRs.manifold = ManifoldMode::On;
+
+  Renderer straight(library, scene, camera, offRs);
+  straight.renderPass(16);
+  const Image expected = straight.image();
+
+  Renderer first(library, scene, camera, autoRs);
+  first.renderPass(8);
+  const GpuScene& gpu = first.gpuScene();
+  REQUIRE(gpu.casters.size() == 2);
+  const std::uint64_t hash = 0x5eedull;
+  cli::Checkpoint written;  // what render --checkpoint writes now: auto resolved to off
+  written.state = first.saveAccumulation();
+  written.seed = autoRs.seed;
+  written.sceneHash = hash;
+  written.identity = cli::accumulationIdentity(cli::ImageSettings{autoRs}, camera, gpu);
+  CHECK(written.identity.find("\nmanifold off\n") != std::string::npos);
+  cli::Checkpoint literal = written;  // what earlier builds wrote: "manifold auto" as given
+  literal.identity = cli::accumulationIdentity(cli::ImageSettings{autoRs}, camera);
+  CHECK(literal.identity.find("\nmanifold auto\n") != std::string::npos);
+
+  for (const cli::Checkpoint* ck : {&written, &literal}) {
+    CAPTURE(ck->identity);
+    const std::string off = cli::accumulationIdentity(cli::ImageSettings{offRs}, camera, gpu);
+    CHECK(cli::checkpointMismatch(*ck, hash, off, &gpu) == "");
+    CHECK(cli::checkpointMismatch(*ck, hash, cli::accumulationIdentity(cli::ImageSettings{autoRs}, camera, gpu), &gpu) == "");
+    // Before the scene is packed the manifold lines are not compared; the seed still is.
+    CHECK(cli::checkpointMismatch(*ck, hash, cli::accumulationIdentity(cli::ImageSettings{onRs}, camera), nullptr) == "");
+    RenderSettings seed2 = offRs;
+    seed2.seed = 6;
+    CHECK(cli::checkpointMismatch(*ck, hash, cli::accumulationIdentity(cli::ImageSettings{seed2}, camera), nullptr) ==
+          "seed: checkpoint 5, this render 6");
+    // --manifold on is another image: refused naming both modes.
+    CHECK(cli::checkpointMismatch(*ck, hash, cli::accumulationIdentity(cli::ImageSettings{onRs}, camera, gpu), &gpu) ==
+          "manifold: checkpoint off, this render on");
+
+    Renderer resumed(library, scene, camera, offRs);
+    resumed.restoreAccumulation(ck->state);
+    resumed.renderPass(8);
+    const Image got = resumed.image();
+    REQUIRE(got.rgb.size() == expected.rgb.size());
+    CHECK(meanOf(expected) > 0.01);
+    CHECK(differing(got.rgb, expected.rgb) == 0);
+  }
+}
+
+TEST_CASE("resume from a checkpoint: one of --manifold off does not continue auto where auto finds casters, nor auto on where it takes only some") {
+  // lamp-caustics: its small lamp puts both casters under auto, which then renders what on does.
+  Scene lamp = loadScene(sourcePath("assets/scenes/lamp-caustics.gltf"));
+  const Camera camera = sceneCamera(lamp);
+  RenderSettings rs = smallSettings(8, 8, Integrator::Mis, 1), offRs = rs, onRs = rs;
+  rs.manifold = ManifoldMode::Auto;
+  offRs.manifold = ManifoldMode::Off;
+  onRs.manifold = ManifoldMode::On;
+  {
+    Renderer renderer(testShaderLibrary(), lamp, camera, rs);
+    const GpuScene& gpu = renderer.gpuScene();
+    cli::Checkpoint older;  // an older build's default, --manifold off
+    older.identity = cli::accumulationIdentity(cli::ImageSettings{offRs}, camera);
+    CHECK(cli::checkpointMismatch(older, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) ==
+          "manifold: checkpoint off, this render on");
+    cli::Checkpoint on;
+    on.identity = cli::accumulationIdentity(cli::ImageSettings{onRs}, camera);
+    CHECK(cli::checkpointMismatch(on, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) == "");
+  }
+  // A glass ball far under a small lamp qualifies, a mirror ball beside it does not: auto sends photons
+  // through the glass only, an image neither on nor off renders, so it stays "auto".
+  const Scene s = lampOverGlassAndMirror();
+  const GpuScene g = packScene(s, buildBvh(s.triangles));
+  REQUIRE(g.casters.size() == 2);
+  CHECK(cli::imageManifoldMode(ManifoldMode::Auto, g) == ManifoldMode::Auto);
+  cli::Checkpoint on;
+  on.identity = cli::accumulationIdentity(cli::ImageSettings{onRs}, camera);
+  CHECK(cli::checkpointMismatch(on, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, g), &g) ==
+        "manifold: checkpoint on, this render auto");
+  for (ManifoldMode m : {ManifoldMode::On, ManifoldMode::Off}) CHECK(cli::imageManifoldMode(m, g) == m);
 }

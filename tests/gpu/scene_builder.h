@@ -150,4 +150,22 @@ inline Camera lookAt(glm::vec3 eye, glm::vec3 target, float yfov) {
   return c;
 }
 
+// A glass ball far under a 16-cm lamp (0.007 sr from its centre: --manifold auto takes it) and a mirror
+// ball close beside the lamp (0.04 sr: auto leaves it), over a diffuse floor, with a camera: the scene
+// where auto sends photons through some casters only.
+inline Scene lampOverGlassAndMirror() {
+  Scene s;
+  Material mirror = diffuseMaterial(0.9f);
+  mirror.metallic = 1.0f;
+  s.materials = {diffuseMaterial(0.8f), emitterMaterial(60.0f), glassMaterial(1.5f), mirror};
+  addQuad(s, {-1.5f, 0, 1.5f}, {1.5f, 0, 1.5f}, {1.5f, 0, -1.5f}, {-1.5f, 0, -1.5f}, 0);
+  const float h = 0.08f;
+  addQuad(s, {-h, 2.5f, -h}, {h, 2.5f, -h}, {h, 2.5f, h}, {-h, 2.5f, h}, 1);
+  addSphere(s, {0.0f, 0.62f, 0.0f}, 0.3f, 24, 2);
+  addSphere(s, {0.5f, 2.0f, 0.0f}, 0.15f, 16, 3);
+  finishBounds(s);
+  s.cameras.push_back(lookAt({0.0f, 1.4f, 1.9f}, {0.0f, 0.0f, 0.0f}, 0.9f));
+  return s;
+}
+
 }  // namespace caustica::test
