@@ -176,16 +176,30 @@ std::string identityWithoutManifold(const std::string& identity) {
   return editManifoldLine(identity, [](const std::string&) { return std::string(); });
 }
 
+float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {
+  const bool guides = s.integrator == Integrator::Mis && s.casterProbability > 0.0f && !gpu.casters.empty() &&
+                      gpu.emitterCount > 0;
+  return guides ? s.guideProbability : 0.0f;
+}
+
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu) {
   ImageSettings s = settings;
   s.render.manifold = imageManifoldMode(s.render.manifold, gpu);
+  s.render.guideProbability = imageGuideProbability(s.render, gpu);
   return accumulationIdentity(s, camera);
 }
 
 std::string identityDifference(const std::string& a, const std::string& b, const std::string& labelA,
                                const std::string& labelB) {
   std::vector<std::string> diffs;
-  const std::map<std::string, std::string> ma = parseLines(a), mb = parseLines(b);
+  std::map<std::string, std::string> ma = parseLines(a), mb = parseLines(b);
+  // Settings added after identities were first written, with the value their absence means: an
+  // identity from before caster guiding rendered without it.
+  static const std::map<std::string, std::string> kAddedLater = {{"guide-probability", "0"}};
+  for (const auto& [key, value] : kAddedLater) {
+    if (!ma.count(key) && mb.count(key)) ma[key] = value;
+    if (!mb.count(key) && ma.count(key)) mb[key] = value;
+  }
   for (const auto& [key, value] : mb) {
     auto it = ma.find(key);
     const std::string other = it == ma.end() ? "(none)" : it->second;
