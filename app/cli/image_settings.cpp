@@ -172,8 +172,12 @@ std::string resolveIdentityManifold(const std::string& identity, const GpuScene&
   });
 }
 
-std::string identityWithoutManifold(const std::string& identity) {
-  return editManifoldLine(identity, [](const std::string&) { return std::string(); });
+std::string identityWithoutSceneLines(const std::string& identity) {
+  std::string out;
+  std::istringstream in(identity);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("manifold ", 0) != 0 && line.rfind("guide-probability ", 0) != 0) out += line + '\n';
+  return out;
 }
 
 float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {

@@ -118,8 +118,9 @@ ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
 // "manifold auto" literally reads as what auto gives for the scene.
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
-// The identity text without its manifold line: what can be compared before the scene is packed.
-std::string identityWithoutManifold(const std::string& identity);
+// The identity text without its manifold and guide-probability lines (what they mean depends on the
+// scene: imageManifoldMode, imageGuideProbability): what can be compared before the scene is packed.
+std::string identityWithoutSceneLines(const std::string& identity);
 
 // What differs between two identity texts, "key: LABEL-A a, LABEL-B b; ..." (a key missing on one
 // side shows "(none)", except a setting added later, which its absence gives the value it had before:
