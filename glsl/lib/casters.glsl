@@ -93,13 +93,13 @@ float gGuideKappa[kGuideClasses * CAUSTICA_MAX_CASTERS];   // concentration
 float gGuideNorm[kGuideClasses * CAUSTICA_MAX_CASTERS];    // kappa / (2 pi (1 - exp(-2 kappa))): the pdf at the axis
 float gGuideWeight[kGuideClasses * CAUSTICA_MAX_CASTERS];  // 0: no lobe
 
-// The guide lobe of caster i and photon class cls at p (unit normal n): a vMF fitted to the directions
-// its photons came from in p's cell (mean direction; concentration from their mean resultant length,
-// Banerjee et al. 2005). False without enough photons or when they came from below the surface.
-bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kappa) {
+// The guide lobe fitted to a guide cell (count x, summed direction yzw as int bits of kCellDirScale) at a
+// vertex with unit normal n: a vMF about the photons' mean direction, its concentration from their mean
+// resultant length r (Banerjee et al. 2005: kappa = r (3 - r^2) / (1 - r^2)). False without enough
+// photons or when they came from below the surface.
+bool guideLobe(uvec4 cell, vec3 n, out vec3 axis, out float kappa) {
   axis = n;
   kappa = 0.0;
-  uvec4 cell = casterGuideCell(i, cls, p);
   if (cell.x < kMinGuidePhotons) return false;
   vec3 sum = vec3(ivec3(cell.yzw)) / (float(cell.x) * kCellDirScale);
   float len = length(sum);
@@ -108,6 +108,11 @@ bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kapp
   kappa = min(r * (3.0 - r * r) / (1.0 - r * r), kMaxGuideKappa);
   axis = sum / len;
   return true;
+}
+
+// The guide lobe of caster i and photon class cls at p (unit normal n): guideLobe of p's guide cell.
+bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kappa) {
+  return guideLobe(casterGuideCell(i, cls, p), n, axis, kappa);
 }
 
 // The vMF density (per steradian) of lobe j at unit direction w, 1 - cos from |w - axis|^2 / 2.
