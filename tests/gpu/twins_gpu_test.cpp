@@ -742,6 +742,20 @@ CasterVertex prepareCasters(const gpu::CasterParams& c, const glm::vec3& p, cons
                                   guideCells, c.params.z);
 }
 
+// The GPU's diffuseDirectionPdf gPdf against the C++ twin's on caster state v: relative where the caster
+// term dominates (pdf > 1), absolute where the cosine term does (dot(n, w) carries an absolute rounding),
+// beyond its spread: the pdf jumps at the cones' rims, so how far it moves as every rim moves by kNudge.
+double pdfDifference(const CasterVertex& v, float a, const glm::vec3& n, const glm::vec3& w, float gPdf) {
+  auto pdfAt = [&](float rimScale) {
+    CasterVertex moved = v;
+    for (std::uint32_t k = 0; k < v.usable; ++k) moved.oneMinusCos[k] *= rimScale;
+    return diffuseDirectionPdf(moved, a, n, w);
+  };
+  float cPdf = pdfAt(1.0f);
+  double spread = std::max(absDiff(pdfAt(1.0f - kNudge), cPdf), absDiff(pdfAt(1.0f + kNudge), cPdf));
+  return (absDiff(gPdf, cPdf) - spread) / std::max(1.0, std::abs(static_cast<double>(cPdf)));
+}
+
 }  // namespace
 
 TEST_CASE("GLSL caster state equals its C++ twin: prepareCasters, diffuseDirectionPdf, sampleDiffuseDirection") {
@@ -807,16 +821,8 @@ TEST_CASE("GLSL caster state equals its C++ twin: prepareCasters, diffuseDirecti
         dOmc.add(relDiff(g.f(1 + k, 3), v.oneMinusCos[k]), where);
         dInv.add(relDiff(g.f(9 + k / 4, k % 4), v.invSolidAngle[k]), where);
       }
-      // The pdf jumps at the rims of the cones: its spread is how far it moves as every rim moves by kNudge.
-      auto pdfAt = [&](float rimScale) {
-        CasterVertex moved = v;
-        for (std::uint32_t k = 0; k < v.usable; ++k) moved.oneMinusCos[k] *= rimScale;
-        return diffuseDirectionPdf(moved, scene.params.x, nn, w);
-      };
-      float cPdf = pdfAt(1.0f), gPdf = pdf[i].f(0);
-      double spread = std::max(absDiff(pdfAt(1.0f - kNudge), cPdf), absDiff(pdfAt(1.0f + kNudge), cPdf));
-      dPdf.add((absDiff(gPdf, cPdf) - spread) / std::max(1.0, std::abs(static_cast<double>(cPdf))),
-               [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
+      float gPdf = pdf[i].f(0), cPdf = diffuseDirectionPdf(v, scene.params.x, nn, w);
+      dPdf.add(pdfDifference(v, scene.params.x, nn, w, gPdf), [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
       glm::vec3 cDir = sampleDiffuseDirection(v, scene.params.x, nn, uPick, glm::vec2(arg(in[i], 3)));
       dDir.add(absDiff(dir[i].v(0), cDir), [&] { return str(in[i]) + ": " + str(dir[i].v(0)) + " vs " + str(cDir); });
     }
@@ -1048,18 +1054,10 @@ TEST_CASE("GLSL caster guiding equals its C++ twin: guideLobe; prepareCasters, d
           dGNorm.add(relDiff(g.f(27 + j / 4, j % 4), v.guideNorm[j]) / (1.0 + kappa - 1.0 / std::expm1(-2.0 * kappa)), where);
         }
       }
-      // The pdf and the sampler on the GPU's state: their own arithmetic alone. The pdf jumps at the
-      // cones' rims: its spread is how far it moves as every rim moves by kNudge.
+      // The pdf and the sampler on the GPU's state: their own arithmetic alone.
       CasterVertex gv = casterVertexOf(g);
-      auto pdfAt = [&](float rimScale) {
-        CasterVertex moved = gv;
-        for (std::uint32_t k = 0; k < gv.usable; ++k) moved.oneMinusCos[k] *= rimScale;
-        return diffuseDirectionPdf(moved, scene.params.x, nn, w);
-      };
-      float cPdf = pdfAt(1.0f), gPdf = pdf[i].f(0);
-      double spread = std::max(absDiff(pdfAt(1.0f - kNudge), cPdf), absDiff(pdfAt(1.0f + kNudge), cPdf));
-      dPdf.add((absDiff(gPdf, cPdf) - spread) / std::max(1.0, std::abs(static_cast<double>(cPdf))),
-               [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
+      float gPdf = pdf[i].f(0), cPdf = diffuseDirectionPdf(gv, scene.params.x, nn, w);
+      dPdf.add(pdfDifference(gv, scene.params.x, nn, w, gPdf), [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
       glm::vec2 us(arg(in[i], 3));
       glm::vec3 cDir = sampleDiffuseDirection(gv, scene.params.x, nn, uPick, us);
       dDir.add(absDiff(dir[i].v(0), cDir) - lobeSpread(gv, scene.params.x, nn, uPick, us, cDir),
