@@ -93,13 +93,13 @@ float gGuideKappa[kGuideClasses * CAUSTICA_MAX_CASTERS];   // concentration
 float gGuideNorm[kGuideClasses * CAUSTICA_MAX_CASTERS];    // kappa / (2 pi (1 - exp(-2 kappa))): the pdf at the axis
 float gGuideWeight[kGuideClasses * CAUSTICA_MAX_CASTERS];  // 0: no lobe
 
-// The guide lobe of caster i and photon class cls at p (unit normal n): a vMF fitted to the directions
-// its photons came from in p's cell (mean direction; concentration from their mean resultant length,
-// Banerjee et al. 2005). False without enough photons or when they came from below the surface.
-bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kappa) {
+// The guide lobe fitted to a guide cell (count x, summed direction yzw as int bits of kCellDirScale) at a
+// vertex with unit normal n: a vMF about the photons' mean direction, its concentration from their mean
+// resultant length r (Banerjee et al. 2005: kappa = r (3 - r^2) / (1 - r^2)). False without enough
+// photons or when they came from below the surface.
+bool guideLobe(uvec4 cell, vec3 n, out vec3 axis, out float kappa) {
   axis = n;
   kappa = 0.0;
-  uvec4 cell = casterGuideCell(i, cls, p);
   if (cell.x < kMinGuidePhotons) return false;
   vec3 sum = vec3(ivec3(cell.yzw)) / (float(cell.x) * kCellDirScale);
   float len = length(sum);
@@ -109,6 +109,17 @@ bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kapp
   axis = sum / len;
   return true;
 }
+
+// The guide lobe of caster i and photon class cls at p (unit normal n): guideLobe of p's guide cell.
+bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kappa) {
+  return guideLobe(casterGuideCell(i, cls, p), n, axis, kappa);
+}
+
+// The vMF lobe of concentration kappa about a unit axis: its density at the axis (per steradian; the
+// density at angle theta is that times exp(-kappa (1 - cos theta))), and 1 - cos theta of a direction
+// drawn from it with u in [0, 1) (inverting its cdf; Jakob 2012), at most 2.
+float vmfNorm(float kappa) { return kappa / (2.0 * PI * (1.0 - exp(-2.0 * kappa))); }
+float vmfOneMinusCos(float kappa, float u) { return min(-log(u + (1.0 - u) * exp(-2.0 * kappa)) / kappa, 2.0); }
 
 // The vMF density (per steradian) of lobe j at unit direction w, 1 - cos from |w - axis|^2 / 2.
 float guidePdf(uint j, vec3 w) {
@@ -152,7 +163,7 @@ void prepareCasters(vec3 p, vec3 n, float u) {
       uint j = kGuideClasses * k + c;
       gGuideAxis[j] = gAxis[c];
       gGuideKappa[j] = kappa[c];
-      gGuideNorm[j] = guide[c] ? kappa[c] / (2.0 * PI * (1.0 - exp(-2.0 * kappa[c]))) : 0.0;
+      gGuideNorm[j] = guide[c] ? vmfNorm(kappa[c]) : 0.0;
       gGuideWeight[j] = guide[c] ? share : 0.0;
     }
 #endif
@@ -186,7 +197,8 @@ float diffuseDirectionPdf(vec3 n, vec3 w) {
 }
 
 // Diffuse bounce direction at the prepared vertex (unit normal n): with probability casters.params.x
-// (when a caster is usable) a uniform direction in the picked caster's cone, else a cosine-weighted one.
+// (when a caster is usable) a uniform direction in the picked caster's cone (with caster guiding, or a
+// direction from one of its guide lobes, by their weights), else a cosine-weighted one.
 // sampleUniformCone and sampleCosineHemisphere written as one body with per-lane selected inputs (the
 // same arithmetic for each: llvmpipe runs both sides of a branch, so two bodies cost two cos/sin pairs,
 // two bases and two normalisations on every bounce).
@@ -205,9 +217,8 @@ vec3 sampleDiffuseDirection(vec3 n, float uPick, vec2 u) {
       float w0 = run;
       run += gGuideWeight[j];
       if (v >= w0 && v < run) {
-        float kappa = gGuideKappa[j];
         axis = gGuideAxis[j];
-        omcT = min(-log(u.x + (1.0 - u.x) * exp(-2.0 * kappa)) / kappa, 2.0);  // vMF (Jakob 2012)
+        omcT = vmfOneMinusCos(gGuideKappa[j], u.x);
       }
     }
 #endif
