@@ -32,6 +32,11 @@ layout(std430, binding = CAUSTICA_BINDING_PHOTON_EMITTERS) readonly buffer Photo
 
 layout(location = 0) uniform uint photons;         // photons per caster (gl_GlobalInvocationID.x below it)
 layout(location = 1) uniform uint emitterEntries;  // entries per caster of photonEmitters; 0: the light tree chooses
+layout(location = 2) uniform uint table;           // kTableManifold or kTableGuide: which table the pass fills
+
+const uint kTableManifold = 0u;  // manifold NEE's: photons follow their caster's own chain exactly
+const uint kTableGuide = 1u;     // caster guiding's: photons follow any chain of smooth events (Fresnel-sampled)
+const uint kMaxGuideEvents = 8u; // smooth events a guide photon may make before it is dropped
 
 // A point on the emitter photon `u` of caster `caster` leaves from: the first entry of the caster's
 // table whose cumulative probability exceeds u (binary search), else (no table) the light tree's choice
@@ -109,18 +114,85 @@ bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
   return false;
 }
 
+// Follows photon `index` of caster `caster` for the guide table: from an emitter towards the caster,
+// then through smooth glass (reflection or refraction chosen by Fresnel) and mirror surfaces of any
+// caster until it reaches a surface with a Lambertian part: its landing point, the unit direction from
+// there back to its last smooth event, and the caster that event belongs to. Photons whose first hit
+// is not on the caster, or that meet a rough or unowned specular surface, are dropped.
+bool traceGuidePhoton(uint caster, uint index, out vec3 landing, out vec3 back, out uint last, out uint cls) {
+  landing = back = vec3(0.0);
+  last = caster;
+  cls = 1u;
+  bool refractive = (casters.count.y & (1u << caster)) != 0u;
+  bool own = true;  // every event so far on the caster, refracted (glass) or reflected (mirror)
+  uvec4 rng = rngSeed(index, caster, 0x7f4a7c15u);
+  vec4 sphere = casters.sphere[caster];
+  LightSample ls;
+  if (!samplePhotonEmitter(caster, sphere.xyz, rand01(rng), rand2(rng), ls)) return false;
+  vec3 axis;
+  float omc;
+  vec3 facing = ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n;
+  if (!casterCone(ls.p, facing, sphere, axis, omc)) return false;
+  vec3 dir = sampleUniformCone(axis, omc, rand2(rng));
+  float side = dot(dir, ls.n);
+  if (!(side > 0.0 || ls.twoSided)) return false;
+  vec3 org = offsetRayOrigin(ls.p, ls.pError, side > 0.0 ? ls.n : -ls.n);
+  vec3 lastP = ls.p;
+  for (uint k = 0u; k <= kMaxGuideEvents; ++k) {
+    Hit hit;
+    if (!traceClosest(org, dir, 3.0e38, hit)) return false;
+    Surface sf;
+    if (!surfaceAt(hit, dir, false, sf)) return false;
+    vec2 metalRough = materialMetalRough(sf.m, sf.uv);
+    bool lambertian = (1.0 - metalRough.x) * (1.0 - sf.m.params.z) > 0.0;
+    if (lambertian) {  // the receiver
+      if (k == 0u) return false;  // direct light, not a caustic
+      cls = own && k == (refractive ? 2u : 1u) ? 0u : 1u;
+      landing = sf.p;
+      back = normalize(lastP - sf.p);
+      return true;
+    }
+    uint owner = casterOwning(sf.p);
+    bool isSmooth = metalRough.y * metalRough.y < kDeltaAlpha;
+    if (owner >= uint(CAUSTICA_MAX_CASTERS) || (k == 0u && owner != caster) || !isSmooth) return false;
+    vec3 next;
+    if (metalRough.x > 0.0) {  // a mirror (metal, no Lambertian part)
+      next = reflect(dir, sf.ns);
+      if (dot(next, sf.ng) <= 0.0) return false;
+      own = own && owner == caster && !refractive;
+    } else {                   // smooth glass
+      float eta = sf.front ? sf.m.params.w : 1.0 / sf.m.params.w;
+      bool transmitted;
+      sampleDielectric(dir, sf.ns, eta, rand01(rng), next, transmitted);
+      if (transmitted ? dot(next, sf.ng) >= 0.0 : dot(next, sf.ng) <= 0.0) return false;
+      own = own && owner == caster && refractive && transmitted;
+    }
+    org = offsetRayOrigin(sf.p, sf.pError, dot(next, sf.ng) > 0.0 ? sf.ng : -sf.ng);
+    dir = next;
+    lastP = sf.p;
+    last = owner;
+  }
+  return false;
+}
+
 void main() {
   uint index = gl_GlobalInvocationID.x, caster = gl_GlobalInvocationID.y;
   // Casters outside count.w (--manifold auto's choice) get no photons: no cells, so manifold NEE
   // never joins through them and a bounce through them keeps weight 1 (path_manifold.glsl).
-  if (index >= photons || caster >= casters.count.x || (casters.count.w & (1u << caster)) == 0u) return;
+  // The guide table: photons to every caster.
+  if (index >= photons || caster >= casters.count.x) return;
+  if (table == kTableManifold && (casters.count.w & (1u << caster)) == 0u) return;
   vec3 landing, back;
-  if (!tracePhoton(caster, index, landing, back)) return;
-  uint key = casterCellKey(caster, landing);
+  uint owner = caster, cls = 0u;
+  if (!(table == kTableGuide ? traceGuidePhoton(caster, index, landing, back, owner, cls)
+                             : tracePhoton(caster, index, landing, back)))
+    return;
+  uint key = table == kTableGuide ? guideCellKey(owner, cls, landing) : casterCellKey(owner, landing);
   if (key == 0u) return;
+  uint mask = table == kTableGuide ? casters.guide.x : casters.count.z;
   // The key's slot: the first of its 8 slots (first bucket, then second) that holds it or was empty. A
   // slot once keyed keeps its key, so every photon of a cell finds the same slot.
-  uvec2 b = cellBuckets(key);
+  uvec2 b = cellBuckets(key) & mask;
   int slot = -1;
   for (uint j = 0u; j < 8u && slot < 0; ++j) {
     uint s = 4u * (j < 4u ? b.x : b.y) + (j & 3u);

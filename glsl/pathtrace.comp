@@ -23,7 +23,7 @@
 #if defined(CAUSTICA_CASTERS) || defined(CAUSTICA_MANIFOLD)
 #include "lib/casters.glsl"
 #endif
-#ifdef CAUSTICA_MANIFOLD
+#if defined(CAUSTICA_MANIFOLD) || defined(CAUSTICA_GUIDING)
 #include "lib/caustic_cells.glsl"
 #endif
 

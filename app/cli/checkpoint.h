@@ -65,7 +65,7 @@ std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t scene
 // The same for a render of the scene packed as `gpu` (Renderer::gpuScene): the manifold lines of both
 // identities are compared as the image sees them (resolveIdentityManifold, cli/image_settings.h), so a
 // checkpoint that recorded "manifold auto" continues with --manifold off where auto finds no caster.
-// With gpu null (before the scene is packed) the manifold lines are left out of the comparison.
+// With gpu null (before the scene is packed) the manifold and guide-probability lines are left out of the comparison.
 std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t sceneHash, const std::string& identity,
                                const GpuScene* gpu);
 

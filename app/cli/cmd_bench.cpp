@@ -15,7 +15,8 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--size", "", "W[xH]", "image size in pixels (default 256; H follows the camera's aspect)"},
       {"--max-seconds", "", "S", "render time per estimator run in seconds (default 20)"},
       {"--integrators", "", "LIST", "estimators to compare, comma-separated: naive, mis (manifold NEE as --manifold says, default auto), "
-       "mis-off (without manifold NEE), manifold (mis with --manifold on) (default naive,mis)"},
+       "mis-off (without manifold NEE), manifold (mis with --manifold on), mis-unguided (mis with --guide-probability 0) "
+       "(default naive,mis)"},
       {"--adaptive", "", "LIST",
        "estimators that also get an adaptive-sampling run, comma-separated (default mis; none for none)"},
       {"--dispersion", "", "LIST", "dispersion modes for scenes with dispersive glass (default rgb,spectral)"},
@@ -36,6 +37,7 @@ int cmdBench(const std::vector<std::string>& args) {
        "256 spp (OUT/denoise.csv, bench-denoise-SCENE.png plots and -pictures.png figures, a summary table; docs/denoising.md)"},
       sceneOptionSpec("--max-depth"),
       sceneOptionSpec("--caster-probability"),
+      sceneOptionSpec("--guide-probability"),
       sceneOptionSpec("--manifold"),
       sceneOptionSpec("--camera"),
       sceneOptionSpec("--backend"),

@@ -305,7 +305,7 @@ void checkSceneForOutput(const LoadedScene& ls, const std::string& out, bool fea
 }
 
 // Refuses a checkpoint of another scene, other settings or another shard. Called before the scene is
-// packed (gpu null: every setting but --manifold, whose image depends on the scene) and again after.
+// packed (gpu null: every setting but --manifold and --guide-probability, whose effect depends on the scene) and again after.
 void checkResumable(const Checkpoint& from, const std::string& resumePath, std::uint64_t sceneHash,
                     const std::string& identity, const std::optional<SampleShare>& share, const GpuScene* gpu) {
   std::string diff = checkpointMismatch(from, sceneHash, identity, gpu);

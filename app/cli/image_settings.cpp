@@ -37,6 +37,9 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
     m << "option --caster-probability needs a number from 0 to " << kMaxCasterProbability;
     throw Error(m.str());
   }
+  s.guideProbability = static_cast<float>(opts.getDouble("--guide-probability", defaults.guideProbability));
+  if (!(s.guideProbability >= 0.0f && s.guideProbability <= 1.0f))
+    throw Error("option --guide-probability needs a number from 0 to 1");
   s.manifold = parseManifoldMode(opts.get("--manifold", settingText(defaults.manifold)));
   s.allFeatures = opts.has("--all-features");
   s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
@@ -169,20 +172,38 @@ std::string resolveIdentityManifold(const std::string& identity, const GpuScene&
   });
 }
 
-std::string identityWithoutManifold(const std::string& identity) {
-  return editManifoldLine(identity, [](const std::string&) { return std::string(); });
+std::string identityWithoutSceneLines(const std::string& identity) {
+  std::string out;
+  std::istringstream in(identity);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("manifold ", 0) != 0 && line.rfind("guide-probability ", 0) != 0) out += line + '\n';
+  return out;
+}
+
+float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {
+  const bool guides = s.integrator == Integrator::Mis && s.casterProbability > 0.0f && !gpu.casters.empty() &&
+                      gpu.emitterCount > 0;
+  return guides ? s.guideProbability : 0.0f;
 }
 
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu) {
   ImageSettings s = settings;
   s.render.manifold = imageManifoldMode(s.render.manifold, gpu);
+  s.render.guideProbability = imageGuideProbability(s.render, gpu);
   return accumulationIdentity(s, camera);
 }
 
 std::string identityDifference(const std::string& a, const std::string& b, const std::string& labelA,
                                const std::string& labelB) {
   std::vector<std::string> diffs;
-  const std::map<std::string, std::string> ma = parseLines(a), mb = parseLines(b);
+  std::map<std::string, std::string> ma = parseLines(a), mb = parseLines(b);
+  // Settings added after identities were first written, with the value their absence means: an
+  // identity from before caster guiding rendered without it.
+  static const std::map<std::string, std::string> kAddedLater = {{"guide-probability", "0"}};
+  for (const auto& [key, value] : kAddedLater) {
+    if (!ma.count(key) && mb.count(key)) ma[key] = value;
+    if (!mb.count(key) && ma.count(key)) mb[key] = value;
+  }
   for (const auto& [key, value] : mb) {
     auto it = ma.find(key);
     const std::string other = it == ma.end() ? "(none)" : it->second;

@@ -110,16 +110,21 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& ca
 // sends photons to no caster (resolveManifold: the off variant), On where it takes every caster On
 // takes (the same variant and photon cells), and stays Auto where it takes some casters only (an image
 // neither On nor Off renders). On and Off stay as given.
+// --guide-probability as the image sees it: 0 where caster guiding is not compiled (naive, no caster
+// aiming, no caster or no emissive triangle), so that such renders continue and merge whatever it says.
+float imageGuideProbability(const RenderSettings& settings, const GpuScene& gpu);
 ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // An identity text with its manifold line replaced by imageManifoldMode for `gpu` (a text without one
 // is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
 // "manifold auto" literally reads as what auto gives for the scene.
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
-// The identity text without its manifold line: what can be compared before the scene is packed.
-std::string identityWithoutManifold(const std::string& identity);
+// The identity text without its manifold and guide-probability lines (what they mean depends on the
+// scene: imageManifoldMode, imageGuideProbability): what can be compared before the scene is packed.
+std::string identityWithoutSceneLines(const std::string& identity);
 
 // What differs between two identity texts, "key: LABEL-A a, LABEL-B b; ..." (a key missing on one
-// side shows "(none)"); "" when they are equal. E.g. labels "checkpoint" and "this render".
+// side shows "(none)", except a setting added later, which its absence gives the value it had before:
+// guide-probability 0); "" when they are equal. E.g. labels "checkpoint" and "this render".
 std::string identityDifference(const std::string& a, const std::string& b, const std::string& labelA,
                                const std::string& labelB);
 

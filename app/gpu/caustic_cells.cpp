@@ -16,13 +16,13 @@ std::uint32_t cellTableBuckets(std::uint32_t casters) {
   return buckets;
 }
 
-std::vector<glm::uvec2> photonEmitterTable(const LightTree& tree, const gpu::CasterParams& cp) {
+std::vector<glm::uvec2> photonEmitterTable(const LightTree& tree, const gpu::CasterParams& cp, std::uint32_t casterMask) {
   const std::size_t n = tree.leavesBySource.size(), casters = cp.count.x;
   if (n == 0 || casters == 0 || static_cast<std::uint64_t>(n) * casters > kMaxPhotonEmitterEntries) return {};
   std::vector<glm::uvec2> table(n * casters, glm::uvec2(0u));
   std::vector<double> cdf(n);
   for (std::size_t c = 0; c < casters; ++c) {
-    if ((cp.count.w & (1u << c)) == 0u) continue;
+    if ((casterMask & (1u << c)) == 0u) continue;
     const glm::dvec3 centre(cp.sphere[c]);
     const double r = cp.sphere[c].w;
     double sum = 0.0;
@@ -61,6 +61,7 @@ bool CausticCells::run(const GlProgram& program, std::uint32_t casters, std::uin
   program.use();
   glUniform1ui(0, kCausticPhotons);
   glUniform1ui(1, entries);
+  glUniform1ui(2, static_cast<std::uint32_t>(table_));
   if (casters > 0) glDispatchCompute((kCausticPhotons + 63u) / 64u, casters, 1u);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
   std::uint32_t dropped = 0;
@@ -91,8 +92,8 @@ CausticCellStats CausticCells::stats() const {
 
 void CausticCells::bind() const {
   if (!built_) return;
-  keysView_.bind(CAUSTICA_TEXUNIT_CELL_KEYS);
-  cellsView_.bind(CAUSTICA_TEXUNIT_CELLS);
+  keysView_.bind(table_ == CellTable::Guide ? CAUSTICA_TEXUNIT_GUIDE_KEYS : CAUSTICA_TEXUNIT_CELL_KEYS);
+  cellsView_.bind(table_ == CellTable::Guide ? CAUSTICA_TEXUNIT_GUIDE_CELLS : CAUSTICA_TEXUNIT_CELLS);
 }
 
 }  // namespace caustica

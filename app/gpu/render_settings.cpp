@@ -47,6 +47,7 @@ void RenderSettings::validate() const {
     m << "caster probability must be between 0 and " << kMaxCasterProbability;
     throw Error(m.str());
   }
+  if (!(guideProbability >= 0.0f && guideProbability <= 1.0f)) throw Error("guide probability must be between 0 and 1");
 }
 
 bool RenderSettings::operator==(const RenderSettings& o) const {
@@ -86,9 +87,10 @@ SettingsChange compareSettings(const RenderSettings& from, const RenderSettings&
   c.resize = from.width != to.width || from.height != to.height;
   c.shader = from.integrator != to.integrator || from.dispersion != to.dispersion ||
              (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.manifold != to.manifold ||
+             (from.guideProbability > 0.0f) != (to.guideProbability > 0.0f) ||
              from.mode != to.mode ||
              from.allFeatures != to.allFeatures;
-  c.casters = from.casterProbability != to.casterProbability;
+  c.casters = from.casterProbability != to.casterProbability || from.guideProbability != to.guideProbability;
   return c;
 }
 

@@ -41,6 +41,10 @@ struct RenderSettings {
   // mis only: probability that a diffuse bounce aims at a caustic caster (a glass or mirror object)
   // instead of cosine sampling; 0 turns it off; at most kMaxCasterProbability.
   float casterProbability = 0.5f;
+  // mis only: probability that a bounce aimed at a caster follows the caster's guide lobe (a direction
+  // lobe fitted to caustic photons that landed near the vertex, docs/path-tracer.md) rather than its
+  // whole cone, where the vertex's cell has one; 0 turns caster guiding off. 0 to 1.
+  float guideProbability = 0.5f;
   // mis only: manifold next-event estimation, which joins the light sample at a path's first diffuse
   // vertex to it through a glass or mirror caster (docs/path-tracer.md); scenes without casters or
   // emitters never use it. Auto (the default) uses it only through the casters whose emitters look
@@ -91,6 +95,7 @@ void visitFields(Settings& s, Visit&& visit) {
   visit("integrator", SettingRole::Accumulation, s.integrator);
   visit("dispersion", SettingRole::Accumulation, s.dispersion);
   visit("caster-probability", SettingRole::Accumulation, s.casterProbability);
+  visit("guide-probability", SettingRole::Accumulation, s.guideProbability);
   visit("manifold", SettingRole::Accumulation, s.manifold);
   visit("mode", SettingRole::Accumulation, s.mode);
   // The same expected image; the same bits on llvmpipe (tests/gpu/error_estimate_test.cpp), to float
@@ -100,7 +105,7 @@ void visitFields(Settings& s, Visit&& visit) {
   visit("samples-per-dispatch", SettingRole::Speed, s.samplesPerDispatch);
 }
 // Added a field to RenderSettings? Add it to visitFields above (with its role), then count it here.
-static_assert(fieldCount<RenderSettings>() == 11, "RenderSettings has a field that visitFields does not list");
+static_assert(fieldCount<RenderSettings>() == 12, "RenderSettings has a field that visitFields does not list");
 
 // A setting's value as one word of text, the same in the checkpoint identity and printed settings
 // (a float as the shortest text that reads back as the same float: 0.05f is "0.05").

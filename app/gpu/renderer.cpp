@@ -121,6 +121,8 @@ void Renderer::setScene(const Scene& scene, const Camera& camera) {
   camera_ = camera;
   raster_.reset();  // the raster pipeline holds the previous scene's mesh
   causticCells_ = CausticCells();  // the photon cells are the previous scene's: program() builds the new ones
+  causticGuides_ = CausticCells(CellTable::Guide);
+  guideTableMask_ = 0;
   cellTableMask_ = 0;
   cellCasters_ = 0;
   loadScene(scene);
@@ -277,9 +279,11 @@ const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
   // The caustic photon pass, once per scene and set of casters (manifoldCasterMask), before the first
   // variant with manifold NEE runs.
-  if ((!causticCells_.built() || cellCasters_ != manifoldCasterMask(settings_.manifold, gpuScene_)) &&
-      std::find(defines.begin(), defines.end(), "CAUSTICA_MANIFOLD") != defines.end())
-    buildCausticCells();
+  auto has = [&](const char* d) { return std::find(defines.begin(), defines.end(), d) != defines.end(); };
+  if ((!causticCells_.built() || cellCasters_ != manifoldCasterMask(settings_.manifold, gpuScene_)) && has("CAUSTICA_MANIFOLD"))
+    buildCausticCells(CellTable::Manifold);
+  // The guide photon pass, once per scene, before the first variant with caster guiding runs.
+  if (!causticGuides_.built() && has("CAUSTICA_GUIDING")) buildCausticCells(CellTable::Guide);
   const char* entry = renderModeSpec(settings_.mode).entryShader;
   if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
   std::string key = std::string(entry) + ":";
@@ -348,7 +352,7 @@ SettingsChange Renderer::apply(const RenderSettings& settings) {
   return change;
 }
 
-void Renderer::buildCausticCells() {
+void Renderer::buildCausticCells(CellTable table) {
   std::vector<std::string> defines = sceneFeatures_.only(FeatureKind::Scene).defines();  // materials as the scene needs
   for (const std::string& split : bufferLayout_.defines()) defines.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) defines.push_back(inst);
@@ -360,20 +364,28 @@ void Renderer::buildCausticCells() {
   frameUbo_.update(0, sizeof fp, &fp);
   bindSceneForDispatch();
   gpu::CasterParams cp = casterParams();
-  cellCasters_ = cp.count.w;
-  causticCells_.build(photons, gpuScene_.lightTree, cp, [&](const gpu::CasterParams& built) {
-    cellTableMask_ = built.count.z;
-    uploadCasters();
-  });
+  if (table == CellTable::Guide) {
+    causticGuides_.build(photons, gpuScene_.lightTree, cp, [&](const gpu::CasterParams& built) {
+      guideTableMask_ = built.guide.x;
+      uploadCasters();
+    });
+  } else {
+    cellCasters_ = cp.count.w;
+    causticCells_.build(photons, gpuScene_.lightTree, cp, [&](const gpu::CasterParams& built) {
+      cellTableMask_ = built.count.z;
+      uploadCasters();
+    });
+  }
   checkGlError("caustic photon pass");
 }
 
 gpu::CasterParams Renderer::casterParams() const {
   gpu::CasterParams cp{};
   cp.count.z = cellTableMask_;
+  cp.guide.x = guideTableMask_;
   cp.count.w = manifoldCasterMask(settings_.manifold, gpuScene_);  // the photon pass's casters
   cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
-  cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, 0.0f, 0.0f);
+  cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, settings_.guideProbability, 0.0f);
   cp.lights = gpuScene_.emitterSphere;
   for (std::uint32_t i = 0; i < cp.count.x; ++i) {
     cp.sphere[i] = gpuScene_.casters[i].sphere;
@@ -574,6 +586,7 @@ void Renderer::bindSceneForDispatch() {
   bvhTextures_.bind();
   shadingTextures_.bind();
   causticCells_.bind();
+  causticGuides_.bind();
   punctualUbo_.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_PUNCTUAL);
 }
 

@@ -192,7 +192,9 @@ class Renderer {
   const FeatureSet& sceneFeatures() const { return sceneFeatures_; }
   std::vector<std::string> shaderDefines() const;
   // The caustic cell table of manifold NEE as its photon pass built it (zero before one ran).
-  CausticCellStats causticCellStats() const { return causticCells_.stats(); }
+  CausticCellStats causticCellStats(CellTable t = CellTable::Manifold) const {
+    return (t == CellTable::Guide ? causticGuides_ : causticCells_).stats();
+  }
   // The point lights of the raster and Whitted modes (emitters grouped, most powerful first).
   const std::vector<LightGroup>& lightGroups() const { return lightGroups_; }
   // Binds the scene's storage blocks, UBOs and textures as the compute shaders read them (before each
@@ -209,7 +211,7 @@ class Renderer {
   Image meansOf(const std::vector<float>& rgba) const;  // meanImage of sums like accum_'s, with coverage alpha
   gpu::CasterParams casterParams() const;  // the caster UBO for the current settings and cells
   // The caustic photon pass (caustic_cells.h), once per scene, before the first manifold NEE variant runs.
-  void buildCausticCells();
+  void buildCausticCells(CellTable table);
   // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
   void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU
@@ -243,6 +245,8 @@ class Renderer {
   std::uint32_t cellTableMask_ = 0;  // CasterParams::count.z: the caustic cell table's bucket mask, once built
   std::uint32_t cellCasters_ = 0;    // the casters (manifoldCasterMask) the cell table was built for
   CausticCells causticCells_;
+  std::uint32_t guideTableMask_ = 0;  // CasterParams::guide.x: the caster guide table's bucket mask, once built
+  CausticCells causticGuides_{CellTable::Guide};
   std::vector<LightGroup> lightGroups_;
   gpu::PointLights pointLights_{};
   GlBuffer pointLightUbo_;

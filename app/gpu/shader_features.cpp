@@ -99,6 +99,12 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        "mis, a caustic caster and --caster-probability > 0", nullptr,
        [](const SceneView& v) { return !v.gpu.casters.empty(); },
        [](const RenderSettings& s) { return s.casterProbability > 0.0f; }, "CAUSTICA_MIS", A::Keep},
+      {"guiding", "CAUSTICA_GUIDING", K::Integrator,
+       "caster guiding: aimed bounces follow a direction lobe fitted to the caustic photons of a guide photon "
+       "pass (glsl/lib/casters.glsl), at every diffuse vertex whose cell they reached",
+       "casters, an emissive triangle and --guide-probability > 0", nullptr,
+       [](const SceneView& v) { return !v.gpu.casters.empty() && v.gpu.emitterCount > 0; },
+       [](const RenderSettings& s) { return s.guideProbability > 0.0f; }, "CAUSTICA_CASTERS", A::Keep},
       {"manifold", "CAUSTICA_MANIFOLD", K::Integrator,
        "manifold next-event estimation: light joined to the first diffuse vertex through one glass or mirror "
        "caster (glsl/lib/path_manifold.glsl), after a caustic photon pass",

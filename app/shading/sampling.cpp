@@ -124,18 +124,63 @@ bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float oneMinus
   return between <= angleCaster + angleLights + margin;
 }
 
+bool guideLobe(const glm::uvec4& cell, const glm::vec3& n, glm::vec3& axis, float& kappa) {
+  axis = n;
+  kappa = 0.0f;
+  if (cell.x < kMinGuidePhotons) return false;
+  glm::vec3 sum = glm::vec3(glm::ivec3(glm::uvec3(cell.y, cell.z, cell.w))) / (static_cast<float>(cell.x) * gpu::kCellDirScale);
+  float len = glm::length(sum);
+  if (!(len > 1.0e-3f) || glm::dot(sum, n) <= 0.0f) return false;
+  float r = std::min(len, 0.9999f);
+  kappa = std::min(r * (3.0f - r * r) / (1.0f - r * r), kMaxGuideKappa);
+  axis = sum / len;
+  return true;
+}
+
+float vmfNorm(float kappa) { return kappa / (2.0f * kPi * (1.0f - std::exp(-2.0f * kappa))); }
+
+float vmfOneMinusCos(float kappa, float u) {
+  return std::min(-std::log(u + (1.0f - u) * std::exp(-2.0f * kappa)) / kappa, 2.0f);
+}
+
+float guidePdf(const CasterVertex& v, std::uint32_t j, const glm::vec3& w) {
+  glm::vec3 d = w - v.guideAxis[j];
+  return v.guideNorm[j] * std::exp(-v.guideKappa[j] * 0.5f * glm::dot(d, d));
+}
+
 CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
-                            std::uint32_t refractMask, const glm::vec4& lights, float margin) {
+                            std::uint32_t refractMask, const glm::vec4& lights, float margin,
+                            const glm::uvec4* guideCells, float guideProbability) {
   CasterVertex v;
   for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(CasterVertex::kMax) && i < count; ++i) {
     glm::vec3 axis;
     float omc;
-    if (!casterCone(p, n, spheres[i], axis, omc)) continue;
-    if ((refractMask & (1u << i)) != 0u && !casterFacesLights(p, axis, omc, lights, margin)) continue;
+    bool cone = casterCone(p, n, spheres[i], axis, omc) &&
+                ((refractMask & (1u << i)) == 0u || casterFacesLights(p, axis, omc, lights, margin));
+    glm::vec3 gAxis[kGuideClasses];
+    float kappa[kGuideClasses];
+    bool guide[kGuideClasses] = {};
+    std::uint32_t guides = 0;
+    for (int c = 0; c < kGuideClasses; ++c) {
+      gAxis[c] = n;
+      kappa[c] = 0.0f;
+      if (guideCells) guide[c] = guideLobe(guideCells[kGuideClasses * i + c], n, gAxis[c], kappa[c]);
+      guides += guide[c];
+    }
+    if (!cone && guides == 0) continue;
     std::uint32_t k = v.usable++;
-    v.axis[k] = axis;
-    v.oneMinusCos[k] = omc;
-    v.invSolidAngle[k] = 1.0f / (2.0f * kPi * omc);
+    v.axis[k] = cone ? axis : n;
+    v.oneMinusCos[k] = cone ? omc : 0.0f;
+    v.invSolidAngle[k] = cone ? 1.0f / (2.0f * kPi * omc) : 0.0f;
+    // The guide lobes share guideProbability of the caster's part equally (all of it without a cone).
+    float share = guides == 0 ? 0.0f : (cone ? guideProbability : 1.0f) / static_cast<float>(guides);
+    for (int c = 0; c < kGuideClasses; ++c) {
+      std::uint32_t j = kGuideClasses * k + c;
+      v.guideAxis[j] = gAxis[c];
+      v.guideKappa[j] = kappa[c];
+      v.guideNorm[j] = guide[c] ? vmfNorm(kappa[c]) : 0.0f;
+      v.guideWeight[j] = guide[c] ? share : 0.0f;
+    }
   }
   if (v.usable > 0) v.pick = std::min(static_cast<std::uint32_t>(u * static_cast<float>(v.usable)), v.usable - 1);
   return v;
@@ -145,19 +190,45 @@ float diffuseDirectionPdf(const CasterVertex& v, float casterProbability, const 
   float cosPdf = std::max(glm::dot(n, w), 0.0f) * kInvPi;
   if (v.usable == 0) return cosPdf;
   float sum = 0.0f;
-  for (std::uint32_t k = 0; k < v.usable; ++k)
-    if (inCone(w, v.axis[k], v.oneMinusCos[k])) sum += v.invSolidAngle[k];
+  for (std::uint32_t k = 0; k < v.usable; ++k) {
+    float coneWeight = 1.0f;
+    for (std::uint32_t c = 0; c < kGuideClasses; ++c) {
+      std::uint32_t j = kGuideClasses * k + c;
+      coneWeight -= v.guideWeight[j];
+      if (v.guideWeight[j] > 0.0f) sum += v.guideWeight[j] * guidePdf(v, j, w);
+    }
+    if (coneWeight > 1.0e-6f && inCone(w, v.axis[k], v.oneMinusCos[k])) sum += coneWeight * v.invSolidAngle[k];
+  }
   return (1.0f - casterProbability) * cosPdf + casterProbability * sum / static_cast<float>(v.usable);
 }
 
+// One body for the cone, the guide lobes and cosine sampling, as the shader has it.
 glm::vec3 sampleDiffuseDirection(const CasterVertex& v, float casterProbability, const glm::vec3& n, float uPick,
                                  const glm::vec2& u) {
-  if (v.usable > 0 && uPick < casterProbability)
-    return sampleUniformCone(v.axis[v.pick], v.oneMinusCos[v.pick], u);
+  bool cone = v.usable > 0 && uPick < casterProbability;
+  glm::vec3 axis = n;
+  float omcT = 0.0f;
+  if (cone) {
+    axis = v.axis[v.pick];
+    omcT = u.x * v.oneMinusCos[v.pick];  // 1 - cos(theta)
+    // A guide lobe instead, chosen with uPick rescaled to [0, 1) over the caster's part.
+    float pick = uPick / casterProbability, run = 0.0f;
+    for (std::uint32_t c = 0; c < kGuideClasses; ++c) {
+      std::uint32_t j = kGuideClasses * v.pick + c;
+      float w0 = run;
+      run += v.guideWeight[j];
+      if (pick >= w0 && pick < run) {
+        axis = v.guideAxis[j];
+        omcT = vmfOneMinusCos(v.guideKappa[j], u.x);
+      }
+    }
+  }
+  float s = std::sqrt(cone ? std::max(0.0f, omcT * (2.0f - omcT)) : u.x);  // sin(theta)
+  float z = cone ? 1.0f - omcT : std::sqrt(std::max(0.0f, 1.0f - u.x));    // cos(theta)
+  float phi = 2.0f * kPi * u.y;
   glm::vec3 t, b;
-  orthonormalBasis(n, t, b);
-  glm::vec3 local = sampleCosineHemisphere(u);
-  return glm::normalize(local.x * t + local.y * b + local.z * n);
+  orthonormalBasis(axis, t, b);
+  return glm::normalize(s * std::cos(phi) * t + s * std::sin(phi) * b + z * axis);
 }
 
 }  // namespace caustica

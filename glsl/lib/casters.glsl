@@ -47,6 +47,18 @@ bool casterFacesLights(vec3 p, vec3 axis, float oneMinusCos, vec4 lights, float 
   return between <= angleCaster + angleLights + margin;
 }
 
+// The index of the first caster whose sphere holds p (the caster a chain vertex belongs to), else
+// CAUSTICA_MAX_CASTERS.
+uint casterOwning(vec3 p) {
+  uint owner = uint(CAUSTICA_MAX_CASTERS);
+  for (uint i = 0u; i < uint(CAUSTICA_MAX_CASTERS); ++i) {
+    if (i >= casters.count.x) break;
+    vec3 d = p - casters.sphere[i].xyz;
+    if (owner == uint(CAUSTICA_MAX_CASTERS) && dot(d, d) <= casters.sphere[i].w * casters.sphere[i].w) owner = i;
+  }
+  return owner;
+}
+
 // Uniform direction in the cone about `axis` with 1 - cos(half angle) = oneMinusCos; pdf 1 / (2 pi oneMinusCos).
 vec3 sampleUniformCone(vec3 axis, float oneMinusCos, vec2 u) {
   float omcT = u.x * oneMinusCos;  // 1 - cos(theta), kept apart so narrow cones stay exact
@@ -58,6 +70,13 @@ vec3 sampleUniformCone(vec3 axis, float oneMinusCos, vec2 u) {
   return normalize(sinT * cos(phi) * t + sinT * sin(phi) * b + cosT * axis);
 }
 
+#ifdef CAUSTICA_GUIDING
+uvec4 casterGuideCell(uint caster, uint cls, vec3 p);  // caustic_cells.glsl
+const uint kMinGuidePhotons = 8u;       // photons a cell needs for a guide lobe
+const float kMaxGuideKappa = 1.0e4;     // the narrowest guide lobe (vMF concentration)
+const uint kGuideClasses = 2u;          // guide lobes per caster: photons of its own chain, of any other
+#endif
+
 // The cones of the casters usable from the current diffuse vertex (prepareCasters), kept for the
 // pdf evaluations that follow at the same vertex: usable ones first.
 uint gCasterUsable = 0u;                        // how many casters are usable from the vertex
@@ -65,8 +84,52 @@ uint gCasterPick = 0u;                          // index into gCasterAxis of the
 vec3 gCasterAxis[CAUSTICA_MAX_CASTERS];         // unit axis of the cone
 float gCasterInvSolidAngle[CAUSTICA_MAX_CASTERS];  // 1 / solid angle of the cone (per steradian)
 float gCasterOneMinusCos[CAUSTICA_MAX_CASTERS];    // 1 - cos of the half angle
+#ifdef CAUSTICA_GUIDING
+// Per usable caster k and photon class c, at [kGuideClasses * k + c]: the guide lobe, a vMF about the
+// mean direction its photons came from in the vertex's cell, and its probability within the caster's
+// share (the cone has the rest).
+vec3 gGuideAxis[kGuideClasses * CAUSTICA_MAX_CASTERS];
+float gGuideKappa[kGuideClasses * CAUSTICA_MAX_CASTERS];   // concentration
+float gGuideNorm[kGuideClasses * CAUSTICA_MAX_CASTERS];    // kappa / (2 pi (1 - exp(-2 kappa))): the pdf at the axis
+float gGuideWeight[kGuideClasses * CAUSTICA_MAX_CASTERS];  // 0: no lobe
 
-// Finds the casters usable from p (unit normal n) and picks one of them uniformly with u.
+// The guide lobe fitted to a guide cell (count x, summed direction yzw as int bits of kCellDirScale) at a
+// vertex with unit normal n: a vMF about the photons' mean direction, its concentration from their mean
+// resultant length r (Banerjee et al. 2005: kappa = r (3 - r^2) / (1 - r^2)). False without enough
+// photons or when they came from below the surface.
+bool guideLobe(uvec4 cell, vec3 n, out vec3 axis, out float kappa) {
+  axis = n;
+  kappa = 0.0;
+  if (cell.x < kMinGuidePhotons) return false;
+  vec3 sum = vec3(ivec3(cell.yzw)) / (float(cell.x) * kCellDirScale);
+  float len = length(sum);
+  if (!(len > 1.0e-3) || dot(sum, n) <= 0.0) return false;
+  float r = min(len, 0.9999);
+  kappa = min(r * (3.0 - r * r) / (1.0 - r * r), kMaxGuideKappa);
+  axis = sum / len;
+  return true;
+}
+
+// The guide lobe of caster i and photon class cls at p (unit normal n): guideLobe of p's guide cell.
+bool casterGuide(uint i, uint cls, vec3 p, vec3 n, out vec3 axis, out float kappa) {
+  return guideLobe(casterGuideCell(i, cls, p), n, axis, kappa);
+}
+
+// The vMF lobe of concentration kappa about a unit axis: its density at the axis (per steradian; the
+// density at angle theta is that times exp(-kappa (1 - cos theta))), and 1 - cos theta of a direction
+// drawn from it with u in [0, 1) (inverting its cdf; Jakob 2012), at most 2.
+float vmfNorm(float kappa) { return kappa / (2.0 * PI * (1.0 - exp(-2.0 * kappa))); }
+float vmfOneMinusCos(float kappa, float u) { return min(-log(u + (1.0 - u) * exp(-2.0 * kappa)) / kappa, 2.0); }
+
+// The vMF density (per steradian) of lobe j at unit direction w, 1 - cos from |w - axis|^2 / 2.
+float guidePdf(uint j, vec3 w) {
+  vec3 d = w - gGuideAxis[j];
+  return gGuideNorm[j] * exp(-gGuideKappa[j] * 0.5 * dot(d, d));
+}
+#endif
+
+// Finds the casters usable from p (unit normal n): those whose cone may be aimed at, and with caster
+// guiding those with a guide lobe at p; picks one of them uniformly with u.
 void prepareCasters(vec3 p, vec3 n, float u) {
   gCasterUsable = 0u;
   gCasterPick = 0u;
@@ -74,33 +137,68 @@ void prepareCasters(vec3 p, vec3 n, float u) {
     if (i >= casters.count.x) break;
     vec3 axis;
     float omc;
-    if (!casterCone(p, n, casters.sphere[i], axis, omc)) continue;
-    if ((casters.count.y & (1u << i)) != 0u && !casterFacesLights(p, axis, omc, casters.lights, casters.params.y))
-      continue;
+    bool cone = casterCone(p, n, casters.sphere[i], axis, omc) &&
+                ((casters.count.y & (1u << i)) == 0u || casterFacesLights(p, axis, omc, casters.lights, casters.params.y));
+#ifdef CAUSTICA_GUIDING
+    vec3 gAxis[kGuideClasses];
+    float kappa[kGuideClasses];
+    bool guide[kGuideClasses];
+    uint guides = 0u;
+    for (uint c = 0u; c < kGuideClasses; ++c) {
+      guide[c] = casterGuide(i, c, p, n, gAxis[c], kappa[c]);
+      if (guide[c]) ++guides;
+    }
+    if (!cone && guides == 0u) continue;
+#else
+    if (!cone) continue;
+#endif
     uint k = gCasterUsable++;
-    gCasterAxis[k] = axis;
-    gCasterOneMinusCos[k] = omc;
-    gCasterInvSolidAngle[k] = 1.0 / (2.0 * PI * omc);
+    gCasterAxis[k] = cone ? axis : n;
+    gCasterOneMinusCos[k] = cone ? omc : 0.0;
+    gCasterInvSolidAngle[k] = cone ? 1.0 / (2.0 * PI * omc) : 0.0;
+#ifdef CAUSTICA_GUIDING
+    // The guide lobes share casters.params.z of the caster's part equally (all of it without a cone).
+    float share = guides == 0u ? 0.0 : (cone ? casters.params.z : 1.0) / float(guides);
+    for (uint c = 0u; c < kGuideClasses; ++c) {
+      uint j = kGuideClasses * k + c;
+      gGuideAxis[j] = gAxis[c];
+      gGuideKappa[j] = kappa[c];
+      gGuideNorm[j] = guide[c] ? vmfNorm(kappa[c]) : 0.0;
+      gGuideWeight[j] = guide[c] ? share : 0.0;
+    }
+#endif
   }
   if (gCasterUsable > 0u) gCasterPick = min(uint(u * float(gCasterUsable)), gCasterUsable - 1u);
 }
 
 // Density of sampleDiffuseDirection at w (per steradian): (1 - a) cos/pi + a * (mean over the usable
-// casters of [w in cone] / solid angle), a = casters.params.x when some caster is usable, else 0.
+// casters of their part's density: [w in cone] / solid angle, with caster guiding mixed with the guide
+// lobes' vMF densities), a = casters.params.x when some caster is usable, else 0.
 float diffuseDirectionPdf(vec3 n, vec3 w) {
   float cosPdf = max(dot(n, w), 0.0) * INV_PI;
   if (gCasterUsable == 0u) return cosPdf;
   float sum = 0.0;
   for (uint k = 0u; k < uint(CAUSTICA_MAX_CASTERS); ++k) {
     if (k >= gCasterUsable) break;
+#ifdef CAUSTICA_GUIDING
+    float coneWeight = 1.0;
+    for (uint c = 0u; c < kGuideClasses; ++c) {
+      uint j = kGuideClasses * k + c;
+      coneWeight -= gGuideWeight[j];
+      if (gGuideWeight[j] > 0.0) sum += gGuideWeight[j] * guidePdf(j, w);
+    }
+    if (coneWeight > 1.0e-6 && inCone(w, gCasterAxis[k], gCasterOneMinusCos[k])) sum += coneWeight * gCasterInvSolidAngle[k];
+#else
     if (inCone(w, gCasterAxis[k], gCasterOneMinusCos[k])) sum += gCasterInvSolidAngle[k];
+#endif
   }
   float a = casters.params.x;
   return (1.0 - a) * cosPdf + a * sum / float(gCasterUsable);
 }
 
 // Diffuse bounce direction at the prepared vertex (unit normal n): with probability casters.params.x
-// (when a caster is usable) a uniform direction in the picked caster's cone, else a cosine-weighted one.
+// (when a caster is usable) a uniform direction in the picked caster's cone (with caster guiding, or a
+// direction from one of its guide lobes, by their weights), else a cosine-weighted one.
 // sampleUniformCone and sampleCosineHemisphere written as one body with per-lane selected inputs (the
 // same arithmetic for each: llvmpipe runs both sides of a branch, so two bodies cost two cos/sin pairs,
 // two bases and two normalisations on every bounce).
@@ -111,6 +209,19 @@ vec3 sampleDiffuseDirection(vec3 n, float uPick, vec2 u) {
   if (cone) {
     axis = gCasterAxis[gCasterPick];
     omcT = u.x * gCasterOneMinusCos[gCasterPick];  // 1 - cos(theta)
+#ifdef CAUSTICA_GUIDING
+    // A guide lobe instead, chosen with uPick rescaled to [0, 1) over the caster's part.
+    float v = uPick / casters.params.x, run = 0.0;
+    for (uint c = 0u; c < kGuideClasses; ++c) {
+      uint j = kGuideClasses * gCasterPick + c;
+      float w0 = run;
+      run += gGuideWeight[j];
+      if (v >= w0 && v < run) {
+        axis = gGuideAxis[j];
+        omcT = vmfOneMinusCos(gGuideKappa[j], u.x);
+      }
+    }
+#endif
   }
   float s = sqrt(cone ? max(0.0, omcT * (2.0 - omcT)) : u.x);  // sin(theta)
   float z = cone ? 1.0 - omcT : sqrt(max(0.0, 1.0 - u.x));      // cos(theta)

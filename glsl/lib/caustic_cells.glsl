@@ -15,23 +15,28 @@ uint casterCellKey(uint caster, vec3 p) {
   return caster << 29 | u.x << 19 | u.y << 10 | u.z;
 }
 
-// The key's two buckets (indices, under the table's mask casters.count.z).
+// The key of the guide table's cell holding p for caster `caster` and photon class `cls` (0: the
+// caster's own chain, 1: any other; caustic_photons.comp): 3 bits of caster, 1 of class, 10 + 8 + 10 bits
+// of the cell's coordinates about the caster's centre (x, z within +-512 cells, y within +-128); 0 outside.
+uint guideCellKey(uint caster, uint cls, vec3 p) {
+  vec4 sphere = casters.sphere[caster];
+  vec3 c = floor((p - sphere.xyz) / (kCellPerRadius * sphere.w)) + vec3(512.0, 128.0, 512.0);
+  if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(1024.0, 256.0, 1024.0)))) return 0u;
+  uvec3 u = uvec3(c);
+  return caster << 29 | cls << 28 | u.x << 18 | u.y << 10 | u.z;
+}
+
+// The key's two buckets, before the table's bucket mask.
 uvec2 cellBuckets(uint key) {
   uvec4 h = pcg4d(uvec4(key, 0x2545f491u, 0x9e3779b9u, key ^ 0x85ebca6bu));
-  return uvec2(h.x, h.y) & casters.count.z;
+  return uvec2(h.x, h.y);
 }
 
 #ifndef CAUSTICA_PHOTON_PASS
-layout(binding = CAUSTICA_TEXUNIT_CELL_KEYS) uniform usamplerBuffer cellKeys;  // 4 keys per bucket
-layout(binding = CAUSTICA_TEXUNIT_CELLS) uniform usamplerBuffer cellSlots;     // CausticCell per slot
-
-// What the photons of caster `caster` brought to the cell at p: count (x) and summed direction (yzw,
-// int bits); 0 where none came or there is no table.
-uvec4 casterCell(uint caster, vec3 p) {
-  uint key = casterCellKey(caster, p);
-  if (key == 0u || casters.count.z == 0u) return uvec4(0u);
-  uvec2 b = cellBuckets(key);
-  uvec4 k1 = texelFetch(cellKeys, int(b.x)), k2 = texelFetch(cellKeys, int(b.y));
+// The slot of `key` in a table (its keys, 4 per bucket, under bucket mask `mask`), -1 where absent.
+int cellSlot(usamplerBuffer keys, uint mask, uint key) {
+  uvec2 b = cellBuckets(key) & mask;
+  uvec4 k1 = texelFetch(keys, int(b.x)), k2 = texelFetch(keys, int(b.y));
   bvec4 m1 = equal(k1, uvec4(key)), m2 = equal(k2, uvec4(key));
   int slot = -1;
   for (int j = 3; j >= 0; --j) {  // unrolled: straight-line selects
@@ -40,6 +45,34 @@ uvec4 casterCell(uint caster, vec3 p) {
   for (int j = 3; j >= 0; --j) {
     if (m1[j]) slot = int(4u * b.x) + j;
   }
+  return slot;
+}
+
+#ifdef CAUSTICA_MANIFOLD
+layout(binding = CAUSTICA_TEXUNIT_CELL_KEYS) uniform usamplerBuffer cellKeys;  // 4 keys per bucket
+layout(binding = CAUSTICA_TEXUNIT_CELLS) uniform usamplerBuffer cellSlots;     // CausticCell per slot
+
+// What the photons of caster `caster` brought to the cell at p: count (x) and summed direction (yzw,
+// int bits); 0 where none came or there is no table.
+uvec4 casterCell(uint caster, vec3 p) {
+  uint key = casterCellKey(caster, p);
+  if (key == 0u || casters.count.z == 0u) return uvec4(0u);
+  int slot = cellSlot(cellKeys, casters.count.z, key);
   return slot < 0 ? uvec4(0u) : texelFetch(cellSlots, slot);
 }
+#endif
+
+#ifdef CAUSTICA_GUIDING
+layout(binding = CAUSTICA_TEXUNIT_GUIDE_KEYS) uniform usamplerBuffer guideKeys;
+layout(binding = CAUSTICA_TEXUNIT_GUIDE_CELLS) uniform usamplerBuffer guideSlots;
+
+// casterCell of the caster guide table: the photons of class cls whose last smooth event was on caster
+// `caster`.
+uvec4 casterGuideCell(uint caster, uint cls, vec3 p) {
+  uint key = guideCellKey(caster, cls, p);
+  if (key == 0u || casters.guide.x == 0u) return uvec4(0u);
+  int slot = cellSlot(guideKeys, casters.guide.x, key);
+  return slot < 0 ? uvec4(0u) : texelFetch(guideSlots, slot);
+}
+#endif
 #endif

@@ -80,18 +80,6 @@ vec3 reflectDiff(vec3 d, vec3 n, vec3 dD, vec3 dN) {
   return dD + 2.0 * (-(dot(dD, n) + dot(d, dN))) * n + 2.0 * cosI * dN;
 }
 
-// The index of the first caster whose sphere holds p (the caster a chain vertex belongs to), else
-// CAUSTICA_MAX_CASTERS.
-uint casterOwning(vec3 p) {
-  uint owner = uint(CAUSTICA_MAX_CASTERS);
-  for (uint i = 0u; i < uint(CAUSTICA_MAX_CASTERS); ++i) {
-    if (i >= casters.count.x) break;
-    vec3 d = p - casters.sphere[i].xyz;
-    if (owner == uint(CAUSTICA_MAX_CASTERS) && dot(d, d) <= casters.sphere[i].w * casters.sphere[i].w) owner = i;
-  }
-  return owner;
-}
-
 // What manifoldSolve is asked: the chain from x through caster `caster` (index into CasterParams;
 // axis: the unit direction from x to its centre, casterCone's), ending on the plane of the light
 // triangle (unit normal nL of its front face) at y.

@@ -48,6 +48,8 @@ using uint = std::uint32_t;
 #define CAUSTICA_MAX_CASTERS 8        // caustic casters the shader can aim at (CasterParams.sphere[])
 #define CAUSTICA_TEXUNIT_CELL_KEYS 10   // texture unit: buffer texture (rgba32ui) over the caustic cell table's keys (manifold NEE)
 #define CAUSTICA_TEXUNIT_CELLS 11       // texture unit: buffer texture (rgba32ui) over its CausticCell slots
+#define CAUSTICA_TEXUNIT_GUIDE_KEYS 12  // texture unit: buffer texture (rgba32ui) over the caster guide table's keys (guiding)
+#define CAUSTICA_TEXUNIT_GUIDE_CELLS 13 // texture unit: buffer texture (rgba32ui) over its CausticCell slots
 #define CAUSTICA_BINDING_CELL_KEYS 0    // caustic_photons.comp only: SSBO of the cell table's keys (atomic compare-and-swap)
 #define CAUSTICA_BINDING_CELLS 1        // caustic_photons.comp only: SSBO of CausticCell words (atomic adds)
 #define CAUSTICA_BINDING_CELL_DROPS 2   // caustic_photons.comp only: SSBO: photons whose cell found no free slot
@@ -288,12 +290,17 @@ struct CasterParams {
                                           // z: buckets of the caustic cell table - 1 (a power of 2 minus 1; manifold NEE,
                                           // caustic_cells.glsl), 0: no table; w: bit i set = the photon pass sends
                                           // photons to sphere i (manifoldCasterMask; caustic_photons.comp only)
-  vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians); zw unused
+  uvec4 guide;                            // x: buckets of the caster guide table - 1 (caster guiding, caustic_cells.glsl),
+                                          // 0: no table; yzw unused
+  vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians);
+                                          // z: probability that an aimed bounce follows a caster's guide lobe; w unused
   vec4 lights;                            // xyz: centre, w: radius of a sphere around every emitter (world space)
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
 };
 
-// The caustic cell table of manifold NEE (glsl/lib/caustic_cells.glsl, app/gpu/caustic_cells.h): a hash
+// The caustic cell tables (glsl/lib/caustic_cells.glsl, app/gpu/caustic_cells.h), manifold NEE's and caster
+// guiding's (the same layout; guiding's photons follow any chain of smooth events and count for the
+// caster of their last one, CasterParams.guide): a hash
 // table of receiver cells, each caster's cubes of kCellPerRadius times its radius, keyed by caster and
 // cell. Buckets of 4 keys (one uvec4 each; key 0: empty); each slot's CausticCell holds what the
 // caster's photons brought there (uint words, written with atomics by caustic_photons.comp): their
@@ -361,7 +368,7 @@ static_assert(sizeof(Material) == 16 * kMaterialTexels, "Material must be 192 by
 static_assert(sizeof(TexInfo) == 48, "TexInfo must be 48 bytes (std430)");
 static_assert(sizeof(Counters) == 16, "Counters must be 16 bytes (std430)");
 static_assert(sizeof(FrameParams) == 128, "FrameParams must be 128 bytes (std140)");
-static_assert(sizeof(CasterParams) == 48 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
+static_assert(sizeof(CasterParams) == 64 + 16 * CAUSTICA_MAX_CASTERS, "CasterParams must match std140");
 static_assert(sizeof(CausticCell) == 16, "CausticCell must be 16 bytes (one rgba32ui texel)");
 static_assert(sizeof(LightNode) == 64, "LightNode must be 64 bytes (std430)");
 }  // namespace caustica::gpu

@@ -1,6 +1,7 @@
 // twins_test.comp — GPU test entry: runs one GLSL library function (chosen by a uniform) on a batch of
 // input records, so that tests/gpu/twins_gpu_test.cpp can compare it with its C++ twin (app/shading/sampling.h).
-// One invocation per record; #version is injected by the host; no feature defines are needed.
+// One invocation per record; #version is injected by the host. Compiled as it is, and with CAUSTICA_GUIDING
+// for caster guiding's twins (guide cells from a third buffer).
 #include "../shared/gpu_layout.h"
 #include "../lib/rng.glsl"
 #include "../lib/spawn.glsl"
@@ -26,7 +27,7 @@ layout(location = 0) uniform uint recordCount;
 layout(location = 1) uniform uint function;  // one of the constants below (enum Fn in the test)
 
 const uint kInWords = 4u;
-const uint kOutWords = 11u;
+const uint kOutWords = 35u;
 
 const uint kPcg4d = 0u;
 const uint kRngSeed = 1u;
@@ -59,6 +60,18 @@ const uint kOctDecode = 27u;
 const uint kWrapCoord = 28u;
 const uint kLayers = 29u;
 const uint kDenoiseTapWeight = 30u;
+const uint kGuideLobe = 31u;  // with CAUSTICA_GUIDING only
+const uint kVmf = 32u;        // with CAUSTICA_GUIDING only
+
+#ifdef CAUSTICA_GUIDING
+// Per record kGuideClasses * CAUSTICA_MAX_CASTERS guide cells: what casterGuideCell(caster, cls, p)
+// returns at [kGuideClasses * caster + cls] (the record's p is ignored).
+layout(std430, binding = 2) readonly buffer GuideCellBuffer { uvec4 guideCellRec[]; };
+uint gRecord = 0u;  // the record this invocation runs
+uvec4 casterGuideCell(uint caster, uint cls, vec3 p) {
+  return guideCellRec[(gRecord * uint(CAUSTICA_MAX_CASTERS) + caster) * kGuideClasses + cls];
+}
+#endif
 
 // The Bsdf of records for kBsdfEvalPdf and kBsdfSample: a[0].w = alpha, a[1].w = eta,
 // a[2] = (color, lobe), a[3].xy = (f0 grey, f90).
@@ -80,6 +93,9 @@ uint bit(bool b) { return b ? 1u : 0u; }
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= recordCount) return;
+#ifdef CAUSTICA_GUIDING
+  gRecord = i;
+#endif
   uvec4 raw[kInWords];
   vec4 a[kInWords];
   for (uint k = 0u; k < kInWords; ++k) {
@@ -169,12 +185,31 @@ void main() {
       o[1u + k] = bits(gCasterAxis[k], gCasterOneMinusCos[k]);
       o[9u + k / 4u][k % 4u] = floatBitsToUint(gCasterInvSolidAngle[k]);
     }
+#ifdef CAUSTICA_GUIDING  // the guide lobes: (axis, kappa) at 11 + j, norm and weight at 27 and 31 + j / 4
+    for (uint j = 0u; j < kGuideClasses * uint(CAUSTICA_MAX_CASTERS); ++j) {
+      if (j >= kGuideClasses * gCasterUsable) break;
+      o[11u + j] = bits(gGuideAxis[j], gGuideKappa[j]);
+      o[27u + j / 4u][j % 4u] = floatBitsToUint(gGuideNorm[j]);
+      o[31u + j / 4u][j % 4u] = floatBitsToUint(gGuideWeight[j]);
+    }
+#endif
   } else if (function == kDiffuseDirectionPdf) {  // prepareCasters as above, a[2].xyz = w
     prepareCasters(a[0].xyz, a[1].xyz, a[0].w);
     o[0].x = floatBitsToUint(diffuseDirectionPdf(a[1].xyz, a[2].xyz));
   } else if (function == kSampleDiffuseDirection) {  // prepareCasters as above, a[1].w = uPick, a[3].xy = u
     prepareCasters(a[0].xyz, a[1].xyz, a[0].w);
     o[0] = bits(sampleDiffuseDirection(a[1].xyz, a[1].w, a[3].xy), 0.0);
+#ifdef CAUSTICA_GUIDING
+  } else if (function == kGuideLobe) {  // raw[0] = cell, a[1].xyz = n: (axis, kappa), ok
+    vec3 axis;
+    float kappa;
+    bool ok = guideLobe(raw[0], a[1].xyz, axis, kappa);
+    o[0] = bits(axis, kappa);
+    o[1].x = bit(ok);
+  } else if (function == kVmf) {  // a[0].xy = (kappa, u): vmfOneMinusCos, vmfNorm
+    o[0].x = floatBitsToUint(vmfOneMinusCos(a[0].x, a[0].y));
+    o[0].y = floatBitsToUint(vmfNorm(a[0].x));
+#endif
   } else if (function == kGgx) {  // a[0] = (h, alpha), a[1].xyz = wi: D(h), Lambda(h), G1(h), G2(h, wi)
     o[0] = bits(vec4(ggxD(a[0].xyz, a[0].w), ggxLambda(a[0].xyz, a[0].w), ggxG1(a[0].xyz, a[0].w),
                      ggxG2(a[0].xyz, a[1].xyz, a[0].w)));

@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <set>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -127,7 +128,7 @@ TEST_CASE("image settings: every field is read from its option") {
   specs.push_back({"--tonemap", "", "CURVE", ""});
   Options opts("test", "", specs);
   REQUIRE(opts.parse({"--size", "64x32", "--seed", "5", "--max-depth", "9", "--integrator", "naive", "--dispersion",
-                      "spectral", "--caster-probability", "0.25", "--manifold", "on", "--mode", "whitted", "--all-features",
+                      "spectral", "--caster-probability", "0.25", "--guide-probability", "0.75", "--manifold", "on", "--mode", "whitted", "--all-features",
                       "--samples-per-dispatch", "2", "--env", "0.5", "--env-strength", "2", "--env-rotation", "30",
                       "--background", "0.2,0.2,0.2", "--light-radius", "0.05", "--animation", "spin", "--anim-time", "1.5",
                       "--camera", "1", "--exposure", "1.5", "--tonemap", "clamp"}));
@@ -187,4 +188,21 @@ TEST_CASE("image settings: the scene side reaches the scene in applySceneSetting
   CHECK(dark.environment.isDefault);
   CHECK(dark.environment.emits());
   CHECK(dark.background.kind == Background::Kind::Environment);
+}
+
+TEST_CASE("image settings: an identity from before caster guiding reads as guide-probability 0") {
+  const ImageSettings defaults;
+  ImageSettings off = defaults;
+  off.render.guideProbability = 0.0f;
+  const std::string withZero = accumulationIdentity(off, Camera{}), withDefault = accumulationIdentity(defaults, Camera{});
+  // The old text: the same lines without guide-probability.
+  std::string old;
+  std::istringstream in(withZero);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("guide-probability ", 0) != 0) old += line + '\n';
+  REQUIRE(old != withZero);
+  CHECK(identityDifference(old, withZero, "checkpoint", "this render").empty());
+  CHECK(identityDifference(withZero, old, "checkpoint", "this render").empty());
+  CHECK(identityDifference(old, withDefault, "checkpoint", "this render") ==
+        "guide-probability: checkpoint 0, this render 0.5");
 }

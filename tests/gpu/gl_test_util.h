@@ -38,9 +38,10 @@ inline ShaderLibrary& testShaderLibrary() {
   return library;
 }
 
-// A test entry shader of glsl/tests ("tests/NAME.comp"), compiled with its log mapped to the library's files.
-inline GlProgram compileTestShader(const std::string& path) {
-  ExpandedShader src = testShaderLibrary().expand(path, {});
+// A test entry shader of glsl/tests ("tests/NAME.comp") with feature defines, compiled with its log mapped
+// to the library's files.
+inline GlProgram compileTestShader(const std::string& path, const std::vector<std::string>& defines = {}) {
+  ExpandedShader src = testShaderLibrary().expand(path, defines);
   return GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); }, path);
 }
 

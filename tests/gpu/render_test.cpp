@@ -35,7 +35,7 @@ struct BlockStats {
 BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrator, int w, int h, int block, int spp,
                       int renders, std::uint32_t seedBase, std::uint64_t* nonFinite, int maxDepth,
                       float casterProbability = 0.5f, std::vector<std::string>* defines = nullptr,
-                      ManifoldMode manifold = ManifoldMode::Off) {
+                      ManifoldMode manifold = ManifoldMode::Off, float guideProbability = 0.5f) {
   BlockStats b;
   b.blocksX = w / block;
   b.blocksY = h / block;
@@ -46,6 +46,7 @@ BlockStats blockStats(const Scene& scene, const Camera& cam, Integrator integrat
     settings.maxDepth = maxDepth;
     settings.casterProbability = casterProbability;
     settings.manifold = manifold;
+    settings.guideProbability = guideProbability;
     RenderResult res = renderScene(scene, cam, settings, spp);
     *nonFinite += res.stats.nonFinite;
     if (defines) *defines = res.defines;
@@ -363,7 +364,8 @@ std::pair<double, double> blockRegion(const BlockStats& s, int bx0, int by0, int
   return {m, v / renders};  // the variance of the mean
 }
 
-// Manifold NEE against naive and against mis without it on `scene`: blocks, image and quadrants
+// Manifold NEE against naive and against mis without it (and without caster guiding: the estimator
+// manifold NEE improves on) on `scene`: blocks, image and quadrants
 // (checkBlocksAgree), and the caustic region [bx0, bx1) x [by0, by1) of blocks within 4.5 standard
 // errors; naiveBlocks: naive's blocks too. Returns the three estimates' BlockStats (naive, mis, manifold).
 std::array<BlockStats, 3> checkManifoldAgrees(const std::string& what, const Scene& scene, int w, int h, int block,
@@ -374,8 +376,8 @@ std::array<BlockStats, 3> checkManifoldAgrees(const std::string& what, const Sce
   std::uint64_t nonFinite = 0;
   std::vector<std::string> misDefines, manifoldDefines;
   BlockStats naive = blockStats(scene, cam, Integrator::Naive, w, h, block, sppNaive, renders, 700, &nonFinite, 32);
-  BlockStats mis =
-      blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 800, &nonFinite, 32, 0.5f, &misDefines);
+  BlockStats mis = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 800, &nonFinite, 32, 0.5f,
+                              &misDefines, ManifoldMode::Off, 0.0f);
   BlockStats manifold = blockStats(scene, cam, Integrator::Mis, w, h, block, sppMis, renders, 900, &nonFinite, 32, 0.5f,
                                    &manifoldDefines, ManifoldMode::On);
   REQUIRE_FALSE(hasDefine(misDefines, "CAUSTICA_MANIFOLD"));
@@ -554,50 +556,73 @@ struct ManifoldView {
 // 97 % of runs (asserting 0.5 % itself would fail it in only half of them).
 constexpr double kSharpResolution = 0.35;
 
-// Manifold NEE against mis without it and against naive over a view and its four quadrants: each
-// difference within kManifoldSigmas standard errors. Prints, per comparison, the smallest bias of the
-// view's mean the run resolves (kManifoldSigmas standard errors of the difference, relative to the
-// mean) and the largest over its quadrants. CAUSTICA_LONG_TESTS=1 takes longFactor times the samples.
-void checkManifoldUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view,
-                           DispersionMode dispersion = DispersionMode::Rgb, int longFactor = 4) {
+// One estimator of an unbiasedness comparison: its name, settings and samples per render (0: left out).
+struct EstimatorRun {
+  std::string name;
+  RenderSettings settings;
+  int spp = 0;
+  std::uint32_t seedBase = 0;
+};
+
+// The tested estimator against each of `others` over a view and its four quadrants: each difference
+// within kManifoldSigmas standard errors. Prints, per comparison, the smallest bias of the view's mean
+// the run resolves (kManifoldSigmas standard errors of the difference, relative to the mean) and the
+// largest over its quadrants; asserts the mean's against the first of `others` <= kSharpResolution
+// for a sharp view. CAUSTICA_LONG_TESTS=1 takes longFactor times the samples. Returns the renders' shader
+// variants (tested first).
+std::vector<std::vector<std::string>> checkViewAgrees(const std::string& what, const Scene& scene, const ManifoldView& view,
+                                                      const EstimatorRun& tested, const std::vector<EstimatorRun>& others,
+                                                      int longFactor = 4) {
   const int f = longTests() ? longFactor : 1, renders = 4;
   std::uint64_t nonFinite = 0;
-  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
-  settings.dispersion = dispersion;
-  settings.maxDepth = 32;
-  settings.manifold = ManifoldMode::On;
-  const PixelStats manifold = pixelStats(scene, view.camera, settings, view.sppManifold * f, renders, 5000, &nonFinite);
-  settings.manifold = ManifoldMode::Off;
-  const PixelStats mis = pixelStats(scene, view.camera, settings, view.sppMis * f, renders, 6000, &nonFinite);
-  REQUIRE(hasDefine(manifold.defines, "CAUSTICA_MANIFOLD"));
-  REQUIRE_FALSE(hasDefine(mis.defines, "CAUSTICA_MANIFOLD"));
-  std::vector<std::pair<std::string, PixelStats>> others{{"mis", mis}};
-  if (view.sppNaive > 0) {
-    settings.integrator = Integrator::Naive;
-    others.emplace_back("naive", pixelStats(scene, view.camera, settings, view.sppNaive * f, renders, 7000, &nonFinite));
+  const PixelStats t = pixelStats(scene, view.camera, tested.settings, tested.spp * f, renders, tested.seedBase, &nonFinite);
+  std::vector<std::vector<std::string>> variants{t.defines};
+  std::vector<std::pair<std::string, PixelStats>> stats;
+  for (const EstimatorRun& o : others) {
+    if (o.spp <= 0) continue;
+    stats.emplace_back(o.name, pixelStats(scene, view.camera, o.settings, o.spp * f, renders, o.seedBase, &nonFinite));
+    variants.push_back(stats.back().second.defines);
   }
   CHECK(nonFinite == 0);
   static const char* kQuadrant[] = {"", " top left", " top right", " bottom left", " bottom right"};
-  for (const auto& [name, other] : others) {
+  for (size_t k = 0; k < stats.size(); ++k) {
+    const auto& [name, other] = stats[k];
     double worstQuadrant = 0.0;
     for (int q = 0; q < 5; ++q) {
       const int x0 = q == 0 ? 0 : (q - 1) % 2 * 8, y0 = q == 0 ? 0 : (q - 1) / 2 * 8, side = q == 0 ? 16 : 8;
-      const auto [mm, vm] = pixelRegion(manifold, x0, y0, x0 + side, y0 + side);
+      const auto [mm, vm] = pixelRegion(t, x0, y0, x0 + side, y0 + side);
       const auto [mo, vo] = pixelRegion(other, x0, y0, x0 + side, y0 + side);
       const double se = std::sqrt(vm + vo), resolves = 100.0 * kManifoldSigmas * se / mo;
-      INFO(what, ", ", view.name, std::string(kQuadrant[q]), ": manifold ", mm, ", ", name, " ", mo, ", difference ",
-           100.0 * (mm - mo) / mo, " % = ", (mm - mo) / se, " standard errors (one: ", 100.0 * se / mo, " %)");
+      INFO(what, ", ", view.name, std::string(kQuadrant[q]), ": ", tested.name, " ", mm, ", ", name, " ", mo,
+           ", difference ", 100.0 * (mm - mo) / mo, " % = ", (mm - mo) / se, " standard errors (one: ", 100.0 * se / mo, " %)");
       CHECK(mo > 0.0);
       CHECK(std::abs(mm - mo) <= kManifoldSigmas * se);
       if (q > 0) worstQuadrant = std::max(worstQuadrant, resolves);
       if (q == 0) {
-        MESSAGE(what, ", ", view.name, ", manifold ", mm, " against ", name, " ", mo, ": difference ",
+        MESSAGE(what, ", ", view.name, ", ", tested.name, " ", mm, " against ", name, " ", mo, ": difference ",
                 100.0 * (mm - mo) / mo, " % (", (mm - mo) / se, " standard errors); resolves a bias of ", resolves, " %");
-        if (name == "mis" && view.sharp) CHECK(resolves <= kSharpResolution);
+        if (k == 0 && view.sharp) CHECK(resolves <= kSharpResolution);
       }
     }
     MESSAGE(what, ", ", view.name, " quadrants against ", name, ": resolve a bias of ", worstQuadrant, " % or less");
   }
+  return variants;
+}
+
+// Manifold NEE against mis without it and against naive (checkViewAgrees).
+void checkManifoldUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view,
+                           DispersionMode dispersion = DispersionMode::Rgb, int longFactor = 4) {
+  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
+  settings.dispersion = dispersion;
+  settings.maxDepth = 32;
+  RenderSettings on = settings, off = settings, naive = settings;
+  on.manifold = ManifoldMode::On;
+  off.manifold = ManifoldMode::Off;
+  naive.integrator = Integrator::Naive;
+  const auto variants = checkViewAgrees(what, scene, view, {"manifold", on, view.sppManifold, 5000},
+                                        {{"mis", off, view.sppMis, 6000}, {"naive", naive, view.sppNaive, 7000}}, longFactor);
+  REQUIRE(hasDefine(variants[0], "CAUSTICA_MANIFOLD"));
+  REQUIRE_FALSE(hasDefine(variants[1], "CAUSTICA_MANIFOLD"));
 }
 
 // causticScene's focus: the part of its 64 x 64 image within `r` (normalized) of the floor under the ball.
@@ -714,6 +739,55 @@ TEST_CASE("manifold NEE is unbiased: instanced caster") {
   MESSAGE("instanced caster, focus: instanced ", qa[0], " flattened ", qb[0], ": differ by ",
           100.0 * (qa[0] - qb[0]) / qb[0], " %");
   checkManifoldUnbiased("instanced glass ball", inst, {"caustic region (focus)", focus, 0, 512, 128});
+}
+
+namespace {
+
+// Caster guiding (--guide-probability, glsl/lib/casters.glsl) against the same estimator without it
+// and against naive (checkViewAgrees); manifold NEE as `manifold` says in both.
+void checkGuidingUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view, ManifoldMode manifold,
+                          DispersionMode dispersion = DispersionMode::Rgb) {
+  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
+  settings.dispersion = dispersion;
+  settings.maxDepth = 32;
+  settings.manifold = manifold;
+  RenderSettings guided = settings, unguided = settings, naive = settings;
+  guided.guideProbability = 0.5f;
+  unguided.guideProbability = 0.0f;
+  naive.integrator = Integrator::Naive;
+  const auto variants = checkViewAgrees(what, scene, view, {"guided", guided, view.sppManifold, 8000},
+                                        {{"unguided", unguided, view.sppMis, 9000}, {"naive", naive, view.sppNaive, 10000}});
+  REQUIRE(hasDefine(variants[0], "CAUSTICA_GUIDING"));
+  REQUIRE_FALSE(hasDefine(variants[1], "CAUSTICA_GUIDING"));
+}
+
+}  // namespace
+
+// Unbiasedness of caster guiding where its lobes carry the caustic: the glass ball's focus under a
+// 60 cm lamp (without manifold NEE) and mirror-caustic's caustic region (with it, as auto chooses there:
+// the guided bounce is the other side of manifold NEE's MIS weight), each asserted to resolve a 0.5 %
+// bias of the mean against the unguided estimator (ManifoldView::sharp); the rest printed.
+TEST_CASE("caster guiding is unbiased: glass ball focus and mirror-caustic") {
+  Scene ball = causticScene(0.0f, 0.3f);
+  checkGuidingUnbiased("glass ball, 60 cm lamp", ball,
+                       {"caustic region (focus)", causticFocusCamera(ball, 0.01), 2048, 8192, 8192, true}, ManifoldMode::Off);
+  Scene mirror = loadScene(sourcePath("assets/scenes/mirror-caustic.gltf"));
+  ManifoldView region = causticRegion(mirror, 0.30, 0.50, 0.70, 0.85, 1024, 2048, 2048);
+  region.sharp = true;
+  checkGuidingUnbiased("mirror-caustic", mirror, region, ManifoldMode::On);
+}
+
+// The other bundled caustic scenes at what a few seconds each resolve (printed).
+TEST_CASE("caster guiding is unbiased: cornell-glass, lamp-caustics, dispersion") {
+  Scene glass = loadScene(sourcePath("assets/scenes/cornell-glass.gltf"));
+  checkGuidingUnbiased("cornell-glass", glass, causticRegion(glass, 0.14, 0.86, 0.44, 0.96, 1024, 1024, 1024), ManifoldMode::Off);
+  checkGuidingUnbiased("cornell-glass", glass, causticRegion(glass, 0.80, 0.45, 0.95, 0.72, 1024, 1024, 1024), ManifoldMode::Off);
+  Scene lamp = loadScene(sourcePath("assets/scenes/lamp-caustics.gltf"));
+  checkGuidingUnbiased("lamp-caustics", lamp, causticRegion(lamp, 0.30, 0.52, 0.68, 0.82, 0, 512, 512), ManifoldMode::On);
+  Scene disp = causticScene(1.0f, 0.3f);
+  checkGuidingUnbiased("dispersive glass ball, spectral", disp,
+                       {"caustic region (dispersed focus)", causticFocusCamera(disp, 0.03), 512, 1024, 1024}, ManifoldMode::Off,
+                       DispersionMode::Spectral);
 }
 
 TEST_CASE("rgb and spectral dispersion agree in mean brightness, and spread the caustic into colours") {

@@ -125,28 +125,31 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
   MESSAGE("largest deviation of a region's mean: ", worst, " (", worstAt, ")");
 }
 
-// The caustic photon pass of manifold NEE (the default --manifold auto picks it on lamp-caustics) sends
-// its photons from the same emitter points whatever the scene's scale or place, so they land where they
-// did: the same count and the same cells up to a photon on a cell's edge (measured: 92,551 photons in
-// 3,689 or 3,690 cells at every transform). Before, the light tree chose the emitters, and its cones,
-// rebuilt from rounded vertices, lost 6 % fewer photons at x100 (84,644 against 79,880); 0.05 % of the
-// photons and 0.1 % of the cells fail that.
+// The caustic photon passes of manifold NEE (the default --manifold auto picks it on lamp-caustics) and
+// of caster guiding send their photons from the same emitter points whatever the scene's scale or place,
+// so they land where they did: the same count and the same cells up to a photon on a cell's edge
+// (measured: manifold NEE's 92,551 photons in 3,689 or 3,690 cells at every transform). Before, the light
+// tree chose the emitters, and its cones, rebuilt from rounded vertices, lost 6 % fewer photons at x100
+// (84,644 against 79,880); 0.05 % of the photons and 0.1 % of the cells fail that.
 TEST_CASE("stress: the caustic photon pass lands the same photons in the same cells at every scale and place") {
   const std::string path = resolveScenePath("lamp-caustics");
-  auto statsOf = [](const Scene& s) {
-    Renderer r(testShaderLibrary(), s, sceneCamera(s), smallSettings(8, 8));
-    r.renderPass(1);
-    return r.causticCellStats();
-  };
-  const Scene original = loadScene(path);
-  const CausticCellStats ref = statsOf(original);
-  REQUIRE(ref.photons > 0);
-  MESSAGE("lamp-caustics: ", ref.photons, " photons in ", ref.cells, " cells");
-  for (const auto& [tag, t] : transforms) {
-    const CausticCellStats s = statsOf(loadScene(transformedScene(path, tag, t.first, t.second)));
-    INFO(tag, ": ", s.photons, " photons in ", s.cells, " cells, against ", ref.photons, " in ", ref.cells);
-    CHECK(std::abs(double(s.photons) - double(ref.photons)) <= 5e-4 * double(ref.photons));
-    CHECK(std::abs(double(s.cells) - double(ref.cells)) <= 1e-3 * double(ref.cells));
+  for (CellTable table : {CellTable::Manifold, CellTable::Guide}) {
+    const char* name = table == CellTable::Guide ? "guide" : "manifold NEE";
+    auto statsOf = [&](const Scene& s) {
+      Renderer r(testShaderLibrary(), s, sceneCamera(s), smallSettings(8, 8));
+      r.renderPass(1);
+      return r.causticCellStats(table);
+    };
+    const Scene original = loadScene(path);
+    const CausticCellStats ref = statsOf(original);
+    REQUIRE(ref.photons > 0);
+    MESSAGE("lamp-caustics, ", name, " table: ", ref.photons, " photons in ", ref.cells, " cells");
+    for (const auto& [tag, t] : transforms) {
+      const CausticCellStats s = statsOf(loadScene(transformedScene(path, tag, t.first, t.second)));
+      INFO(name, " table, ", tag, ": ", s.photons, " photons in ", s.cells, " cells, against ", ref.photons, " in ", ref.cells);
+      CHECK(std::abs(double(s.photons) - double(ref.photons)) <= 5e-4 * double(ref.photons));
+      CHECK(std::abs(double(s.cells) - double(ref.cells)) <= 1e-3 * double(ref.cells));
+    }
   }
 }
 

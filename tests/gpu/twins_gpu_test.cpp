@@ -4,6 +4,7 @@
 // CAUSTICA_TWINS_REPORT=1 prints every measured maximum.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -38,10 +39,10 @@ enum class Fn : GLuint {
   PowerHeuristic, FresnelDielectric, RefractDir, OffsetRayOrigin, SampleDielectric, CauchyIor,
   ChannelSensitivity, InCone, CasterCone, SampleUniformCone, CasterFacesLights, PrepareCasters,
   DiffuseDirectionPdf, SampleDiffuseDirection, HitPointError, Ggx, GgxSampleVisibleNormal, BsdfEvalPdf, BsdfSample, SpotFalloff, OctDecode,
-  WrapCoord, Layers, DenoiseTapWeight
+  WrapCoord, Layers, DenoiseTapWeight, GuideLobe, Vmf  // the last two: with CAUSTICA_GUIDING only
 };
 
-constexpr int kInWords = 4, kOutWords = 11;  // uvec4 per record, as in twins_test.comp
+constexpr int kInWords = 4, kOutWords = 35;  // uvec4 per record, as in twins_test.comp
 
 // One input record: the shader reads word k as uints (raw[k]) or as float bits (a[k]).
 struct In {
@@ -72,17 +73,23 @@ struct Out {
 };
 static_assert(sizeof(In) == kInWords * 16 && sizeof(Out) == kOutWords * 16, "records are packed uvec4 arrays");
 
-// twins_test.comp, compiled once per test case; run() calls one function on every record.
+// twins_test.comp, compiled once per test case (with `defines`); run() calls one function on every record.
 class GlslTwins {
  public:
-  GlslTwins() : prog_(test::compileTestShader("tests/twins_test.comp")) {}
-  std::vector<Out> run(Fn fn, const std::vector<In>& in, const gpu::CasterParams& casters = {}) const {
+  explicit GlslTwins(const std::vector<std::string>& defines = {})
+      : prog_(test::compileTestShader("tests/twins_test.comp", defines)) {}
+  // guideCells (CAUSTICA_GUIDING): per record kGuideClasses * CAUSTICA_MAX_CASTERS cells, what
+  // casterGuideCell returns.
+  std::vector<Out> run(Fn fn, const std::vector<In>& in, const gpu::CasterParams& casters = {},
+                       const std::vector<glm::uvec4>& guideCells = {}) const {
     GlBuffer inBuf = GlBuffer::fromVector(in);
     GlBuffer outBuf = GlBuffer::create(sizeof(Out) * in.size(), nullptr);
     GlBuffer ubo = GlBuffer::create(sizeof(casters), &casters);
+    GlBuffer cellBuf = GlBuffer::fromVector(guideCells.empty() ? std::vector<glm::uvec4>(1) : guideCells);
     prog_.use();
     inBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
     outBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    cellBuf.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
     ubo.bindBase(GL_UNIFORM_BUFFER, CAUSTICA_BINDING_CASTERS);
     glUniform1ui(0, static_cast<GLuint>(in.size()));
     glUniform1ui(1, static_cast<GLuint>(fn));
@@ -723,13 +730,30 @@ gpu::CasterParams casterScene(Random& r, std::uint32_t count, std::uint32_t refr
   return c;
 }
 
-// The C++ twin on the spheres of a CasterParams block, with every radius scaled and the margin shifted.
+// The C++ twin on the spheres of a CasterParams block, with every radius scaled and the margin shifted;
+// with guide cells (kGuideClasses per caster) and the block's guide probability where guideCells is given.
 CasterVertex prepareCasters(const gpu::CasterParams& c, const glm::vec3& p, const glm::vec3& n, float u,
-                            float radiusScale = 1.0f, float marginShift = 0.0f) {
+                            float radiusScale = 1.0f, float marginShift = 0.0f,
+                            const glm::uvec4* guideCells = nullptr) {
   glm::vec4 spheres[CasterVertex::kMax];
   for (int i = 0; i < CasterVertex::kMax; ++i)
     spheres[i] = glm::vec4(glm::vec3(c.sphere[i]), c.sphere[i].w * radiusScale);
-  return caustica::prepareCasters(p, n, u, spheres, c.count.x, c.count.y, c.lights, c.params.y + marginShift);
+  return caustica::prepareCasters(p, n, u, spheres, c.count.x, c.count.y, c.lights, c.params.y + marginShift,
+                                  guideCells, c.params.z);
+}
+
+// The GPU's diffuseDirectionPdf gPdf against the C++ twin's on caster state v: relative where the caster
+// term dominates (pdf > 1), absolute where the cosine term does (dot(n, w) carries an absolute rounding),
+// beyond its spread: the pdf jumps at the cones' rims, so how far it moves as every rim moves by kNudge.
+double pdfDifference(const CasterVertex& v, float a, const glm::vec3& n, const glm::vec3& w, float gPdf) {
+  auto pdfAt = [&](float rimScale) {
+    CasterVertex moved = v;
+    for (std::uint32_t k = 0; k < v.usable; ++k) moved.oneMinusCos[k] *= rimScale;
+    return diffuseDirectionPdf(moved, a, n, w);
+  };
+  float cPdf = pdfAt(1.0f);
+  double spread = std::max(absDiff(pdfAt(1.0f - kNudge), cPdf), absDiff(pdfAt(1.0f + kNudge), cPdf));
+  return (absDiff(gPdf, cPdf) - spread) / std::max(1.0, std::abs(static_cast<double>(cPdf)));
 }
 
 }  // namespace
@@ -797,16 +821,8 @@ TEST_CASE("GLSL caster state equals its C++ twin: prepareCasters, diffuseDirecti
         dOmc.add(relDiff(g.f(1 + k, 3), v.oneMinusCos[k]), where);
         dInv.add(relDiff(g.f(9 + k / 4, k % 4), v.invSolidAngle[k]), where);
       }
-      // The pdf jumps at the rims of the cones: its spread is how far it moves as every rim moves by kNudge.
-      auto pdfAt = [&](float rimScale) {
-        CasterVertex moved = v;
-        for (std::uint32_t k = 0; k < v.usable; ++k) moved.oneMinusCos[k] *= rimScale;
-        return diffuseDirectionPdf(moved, scene.params.x, nn, w);
-      };
-      float cPdf = pdfAt(1.0f), gPdf = pdf[i].f(0);
-      double spread = std::max(absDiff(pdfAt(1.0f - kNudge), cPdf), absDiff(pdfAt(1.0f + kNudge), cPdf));
-      dPdf.add((absDiff(gPdf, cPdf) - spread) / std::max(1.0, std::abs(static_cast<double>(cPdf))),
-               [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
+      float gPdf = pdf[i].f(0), cPdf = diffuseDirectionPdf(v, scene.params.x, nn, w);
+      dPdf.add(pdfDifference(v, scene.params.x, nn, w, gPdf), [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
       glm::vec3 cDir = sampleDiffuseDirection(v, scene.params.x, nn, uPick, glm::vec2(arg(in[i], 3)));
       dDir.add(absDiff(dir[i].v(0), cDir), [&] { return str(in[i]) + ": " + str(dir[i].v(0)) + " vs " + str(cDir); });
     }
@@ -824,6 +840,248 @@ TEST_CASE("GLSL caster state equals its C++ twin: prepareCasters, diffuseDirecti
     if (reportWanted())
       MESSAGE(usableRecords, " records see casters; in ", refusedByLights,
               " casterFacesLights refuses a refractive one, in ", acceptedByLights, " it accepts one");
+  }
+}
+
+namespace {
+
+constexpr int kCellsPerRecord = kGuideClasses * CasterVertex::kMax;
+
+// Random guide cells at a vertex with unit normal n, kGuideClasses per caster slot: none, too few
+// photons, photons from below, no mean direction, or a lobe about a direction mostly above the surface,
+// from wide (mean resultant length 0.001, kappa 0.003) to the narrowest (all photons alike).
+void randomGuideCells(Random& r, const glm::vec3& n, glm::uvec4* cells) {
+  for (int j = 0; j < kCellsPerRecord; ++j) {
+    int kind = std::min(static_cast<int>(r.uniform() * 8.0f), 7);
+    std::uint32_t count = kind == 0 ? 0u : (kind == 1 ? kMinGuidePhotons - 1 : static_cast<std::uint32_t>(r.logUniform(8.0f, 1e5f)));
+    glm::vec3 dir = glm::normalize(r.unit() + 1.2f * n);
+    if (kind == 2) dir = -dir;
+    float len = kind == 3 ? 5e-4f : (kind == 7 ? 1.0f : 1.0f - r.logUniform(1e-5f, 0.999f));
+    glm::ivec3 sum(glm::round(dir * len * static_cast<float>(count) * gpu::kCellDirScale));
+    cells[j] = glm::uvec4(count, glm::uvec3(sum));
+  }
+}
+
+// The caster state the GPU's prepareCasters left (Fn::PrepareCasters with CAUSTICA_GUIDING), as the C++
+// twin holds it: the C++ pdf and sampler run on it to compare them alone.
+CasterVertex casterVertexOf(const Out& g) {
+  CasterVertex v;
+  v.usable = g.w[0].x;
+  v.pick = g.w[0].y;
+  for (std::uint32_t k = 0; k < v.usable && k < static_cast<std::uint32_t>(CasterVertex::kMax); ++k) {
+    v.axis[k] = g.v(1 + k);
+    v.oneMinusCos[k] = g.f(1 + k, 3);
+    v.invSolidAngle[k] = g.f(9 + k / 4, k % 4);
+  }
+  for (std::uint32_t j = 0; j < kGuideClasses * v.usable && j < static_cast<std::uint32_t>(kCellsPerRecord); ++j) {
+    v.guideAxis[j] = g.v(11 + j);
+    v.guideKappa[j] = g.f(11 + j, 3);
+    v.guideNorm[j] = g.f(27 + j / 4, j % 4);
+    v.guideWeight[j] = g.f(31 + j / 4, j % 4);
+  }
+  return v;
+}
+
+// How far the guided sampler's direction (cDir) moves where it samples a guide lobe as 1 - cos theta
+// moves by 8 eps / kappa + 4 eps (1 - cos theta) (the log's absolute error, twice that measured for
+// vmfOneMinusCos, and its relative rounding), through u.x: d(1 - cos theta)/du = (1 - e) / (kappa x),
+// e = exp(-2 kappa), x = u + (1 - u) e. 0 for the cones and cosine sampling. Large where the lobe is
+// sampled next to its axis or its antipode (the direction moves as the square root of 1 - cos theta
+// or of 1 + cos theta there). llvmpipe flushes e to 0 where it is a float denormal (kappa 43.7 to 51.9),
+// so at u.x = 0 the shader then draws the antipode exactly.
+double lobeSpread(const CasterVertex& v, float a, const glm::vec3& n, float uPick, const glm::vec2& u, const glm::vec3& cDir) {
+  if (v.usable == 0 || !(uPick < a)) return 0.0;
+  float pick = uPick / a, run = 0.0f;
+  int lobe = -1;
+  for (int c = 0; c < kGuideClasses; ++c) {
+    int j = kGuideClasses * static_cast<int>(v.pick) + c;
+    float w0 = run;
+    run += v.guideWeight[j];
+    if (pick >= w0 && pick < run) lobe = j;
+  }
+  if (lobe < 0) return 0.0;
+  double k = v.guideKappa[lobe], e = std::exp(-2.0 * k), x = u.x + (1.0 - u.x) * e;
+  double dt = 8.0 * kEps / k + 4.0 * kEps * vmfOneMinusCos(v.guideKappa[lobe], u.x);
+  double du = dt * k * x / (1.0 - e), spread = 0.0;
+  for (double sign : {-1.0, 1.0}) {
+    float moved = static_cast<float>(std::clamp(u.x + sign * du, 0.0, static_cast<double>(kLastBelowOne)));
+    spread = std::max(spread, absDiff(sampleDiffuseDirection(v, a, n, uPick, glm::vec2(moved, u.y)), cDir));
+  }
+  if (u.x == 0.0f && static_cast<float>(e) < std::numeric_limits<float>::min())
+    spread = std::max(spread, absDiff(-v.guideAxis[lobe], cDir));
+  return spread;
+}
+
+}  // namespace
+
+TEST_CASE("GLSL caster guiding equals its C++ twin: guideLobe; prepareCasters, diffuseDirectionPdf, sampleDiffuseDirection with guide lobes") {
+  GlslTwins gpu({"CAUSTICA_GUIDING"});
+  Random r(7);
+  const size_t n = 4096;
+
+  // kappa = r (3 - r^2) / (1 - r^2) with r up to 0.9999: 1 - r^2 cancels (llvmpipe contracts it to an
+  // fma, the C++ twin rounds r^2 first), so kappa's relative error is about eps / (1 - r^2), which lies
+  // between kappa / 4 and 1 + kappa: relative differences are compared in units of 1 + kappa.
+  auto kappaDiff = [](float g, float c) { return relDiff(g, c) / (1.0 + c); };
+
+  // vmfOneMinusCos and vmfNorm: kappa over the range guideLobe gives, u also at its ends.
+  std::vector<In> vmf;
+  for (float kappa : {3e-3f, 0.01f, 1.0f, 200.0f, 1e4f})
+    for (float u : kUEdges) vmf.push_back(floats(glm::vec4(kappa, u, 0, 0)));
+  while (vmf.size() < n) vmf.push_back(floats(glm::vec4(r.logUniform(3e-3f, 1e4f), r.uniform(), 0, 0)));
+  std::vector<Out> vmfOut = gpu.run(Fn::Vmf, vmf);
+  // 1 - cos theta = -log(x) / kappa: the log's absolute error over kappa (llvmpipe's log and exp against
+  // libm's): measured 5.5e-7 (4.6 ULP of 1). vmfNorm: 1 - exp(-2 kappa) cancels for small kappa, so its
+  // relative error is eps / (1 - exp(-2 kappa)) (1e-5 at kappa 0.003): measured, in those units, 1.8e-7.
+  MaxDiff dVmfT("vmfOneMinusCos times kappa (the log's absolute error)", 8 * kEps),
+      dVmfNorm("vmfNorm (relative, times 1 - exp(-2 kappa))", 4 * kEps);
+  for (size_t i = 0; i < vmf.size(); ++i) {
+    glm::vec4 a = arg(vmf[i], 0);
+    auto where = [&] { return "kappa " + str(a.x) + " u " + str(a.y) + ": " + str(vmfOut[i].f(0, 0)) + " vs " + str(vmfOneMinusCos(a.x, a.y)); };
+    dVmfT.add(absDiff(vmfOut[i].f(0, 0), vmfOneMinusCos(a.x, a.y)) * a.x, where);
+    dVmfNorm.add(relDiff(vmfOut[i].f(0, 1), vmfNorm(a.x)) * -std::expm1(-2.0 * a.x), where);
+  }
+  dVmfT.check();
+  dVmfNorm.check();
+
+  // guideLobe on random cells and normals.
+  std::vector<In> lobes;
+  while (lobes.size() < n) {
+    glm::vec3 nn = r.unit();
+    glm::uvec4 cells[kCellsPerRecord];
+    randomGuideCells(r, nn, cells);
+    for (const glm::uvec4& c : cells) {
+      In x;
+      x.w[0] = c;
+      x.w[1] = sameBits<glm::uvec4>(glm::vec4(nn, 0.0f));
+      lobes.push_back(x);
+    }
+  }
+  std::vector<Out> fitted = gpu.run(Fn::GuideLobe, lobes);
+  Mismatches mLobe("guideLobe: a lobe or none");
+  // The axis: a division by the sum's length: measured 1.2e-7. kappa in units of 1 + kappa (above): measured 9.1e-8.
+  MaxDiff dLobeAxis("guideLobe axis", 4 * kEps), dKappa("guideLobe kappa (relative, over 1 + kappa)", 4 * kEps);
+  int lobeRecords = 0;
+  for (size_t i = 0; i < lobes.size(); ++i) {
+    glm::vec3 nn(arg(lobes[i], 1)), axis;
+    float kappa;
+    bool ok = guideLobe(lobes[i].w[0], nn, axis, kappa);
+    auto where = [&] {
+      const glm::uvec4& c = lobes[i].w[0];
+      return "cell (" + std::to_string(c.x) + ", " + std::to_string(int(c.y)) + ", " + std::to_string(int(c.z)) + ", " +
+             std::to_string(int(c.w)) + ") n " + str(nn);
+    };
+    mLobe.add(fitted[i].b(1) == ok, where);
+    if (fitted[i].b(1) != ok) continue;
+    lobeRecords += ok;
+    dLobeAxis.add(absDiff(fitted[i].v(0), axis), where);
+    if (ok) dKappa.add(kappaDiff(fitted[i].f(0, 3), kappa), where);
+  }
+  mLobe.check();
+  dLobeAxis.check();
+  dKappa.check();
+  CHECK(lobeRecords > static_cast<int>(lobes.size()) / 3);
+
+  gpu::CasterParams scenes[] = {
+      casterScene(r, 8, 0xa5u, glm::vec4(0.0f, 2.5f, 0.0f, 1.0f), 0.3f, 0.1f),  // every slot, some refractive
+      casterScene(r, 3, 0x3u, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.6f, 0.0f),  // no lights: refractive ones by lobes only
+      casterScene(r, 5, 0x0u, glm::vec4(1.0f, 1.0f, 1.0f, 0.5f), 0.9f, 0.2f),   // mirrors only
+  };
+  const float guideProbabilities[] = {0.5f, 1.0f, 0.25f};  // 1: the cones give way to the lobes wholly
+  for (int sc = 0; sc < 3; ++sc) {
+    gpu::CasterParams& scene = scenes[sc];
+    scene.params.z = guideProbabilities[sc];
+    CAPTURE(sc);
+    std::vector<In> in;
+    std::vector<glm::uvec4> cells(n * kCellsPerRecord);
+    while (in.size() < n) {
+      glm::vec3 p = r.inBox(3.0f), nn = r.unit();
+      glm::uvec4* c = &cells[in.size() * kCellsPerRecord];
+      randomGuideCells(r, nn, c);
+      float u = in.size() % 64 == 0 ? 0.0f : (in.size() % 64 == 1 ? kLastBelowOne : r.uniform());
+      CasterVertex v = prepareCasters(scene, p, nn, u, 1.0f, 0.0f, c);
+      glm::vec2 uw(in.size() % 8 == 1 ? 1.0f : r.uniform(), r.uniform());
+      glm::vec3 w = in.size() % 2 ? sampleDiffuseDirection(v, scene.params.x, nn, r.uniform(), uw) : r.unit();
+      float uPick = in.size() % 16 == 5 ? scene.params.x : r.uniform();
+      glm::vec2 us = in.size() % 32 == 3 ? glm::vec2(0.0f, 0.5f) : (in.size() % 32 == 4 ? glm::vec2(kLastBelowOne, 0.5f) : r.u2());
+      in.push_back(floats(glm::vec4(p, u), glm::vec4(nn, uPick), glm::vec4(w, 0), glm::vec4(us, 0, 0)));
+    }
+    std::vector<Out> prep = gpu.run(Fn::PrepareCasters, in, scene, cells),
+                     pdf = gpu.run(Fn::DiffuseDirectionPdf, in, scene, cells),
+                     dir = gpu.run(Fn::SampleDiffuseDirection, in, scene, cells);
+    Mismatches mUsable("guided prepareCasters: usable and pick");
+    // Cones as in the unguided test above (1 - cos measured 4.3e-7 here, near a sphere). Lobes: axis and kappa as guideLobe; the norm as kappa and
+    // vmfNorm's cancellation (units of 1 + kappa + 1 / (1 - exp(-2 kappa))); weights are exact
+    // (guideProbability over 1 or 2). The pdf on the GPU's state: as unguided, and the lobes' exp of
+    // kappa t up to log(norm) = 7.4 (where the pdf passes 1) carries 7.4 eps of relative error: measured 6.1e-7.
+    // The direction: as unguided, and beyond its spread as a lobe's 1 - cos theta moves by the log's
+    // error (lobeSpread): measured 1.2e-7.
+    MaxDiff dAxis("guided prepareCasters cone axis", 4 * kEps), dOmc("guided prepareCasters 1 - cos (relative)", 8 * kEps),
+        dInv("guided prepareCasters 1 / solid angle (relative)", 8 * kEps),
+        dGAxis("guided prepareCasters lobe axis", 4 * kEps), dGKappa("guided prepareCasters lobe kappa (relative, over 1 + kappa)", 4 * kEps),
+        dGNorm("guided prepareCasters lobe norm (relative, in units of its condition)", 4 * kEps),
+        dGWeight("guided prepareCasters lobe weight (relative)", 0.0),
+        dPdf("guided diffuseDirectionPdf (relative above 1, absolute below; beyond its spread)", 16 * kEps),
+        dDir("guided sampleDiffuseDirection (beyond its spread)", 4 * kEps);
+    int lobeSamples = 0, lobesPrepared = 0;
+    for (size_t i = 0; i < n; ++i) {
+      glm::vec3 p(arg(in[i], 0)), nn(arg(in[i], 1)), w(arg(in[i], 2));
+      float u = arg(in[i], 0).w, uPick = arg(in[i], 1).w;
+      const glm::uvec4* c = &cells[i * kCellsPerRecord];
+      CasterVertex v = prepareCasters(scene, p, nn, u, 1.0f, 0.0f, c);
+      const Out& g = prep[i];
+      bool same = g.w[0].x == v.usable && g.w[0].y == v.pick;
+      CasterVertex lo = prepareCasters(scene, p, nn, u, 1.0f - kNudge, -kAsinBand, c),
+                   hi = prepareCasters(scene, p, nn, u, 1.0f + kNudge, kAsinBand, c);
+      mUsable.add(same, lo.usable != hi.usable || lo.pick != hi.pick, [&] {
+        return str(in[i]) + ": " + std::to_string(g.w[0].x) + ", " + std::to_string(g.w[0].y) + " vs " +
+               std::to_string(v.usable) + ", " + std::to_string(v.pick);
+      });
+      if (!same) continue;
+      for (std::uint32_t k = 0; k < v.usable; ++k) {
+        auto where = [&] { return str(in[i]) + ", caster " + std::to_string(k); };
+        dAxis.add(absDiff(g.v(1 + k), v.axis[k]), where);
+        dOmc.add(relDiff(g.f(1 + k, 3), v.oneMinusCos[k]), where);
+        dInv.add(relDiff(g.f(9 + k / 4, k % 4), v.invSolidAngle[k]), where);
+        for (std::uint32_t cl = 0; cl < static_cast<std::uint32_t>(kGuideClasses); ++cl) {
+          std::uint32_t j = kGuideClasses * k + cl;
+          dGWeight.add(relDiff(g.f(31 + j / 4, j % 4), v.guideWeight[j]), where);
+          if (v.guideWeight[j] == 0.0f) continue;
+          ++lobesPrepared;
+          dGAxis.add(absDiff(g.v(11 + j), v.guideAxis[j]), where);
+          double kappa = v.guideKappa[j];
+          dGKappa.add(kappaDiff(g.f(11 + j, 3), v.guideKappa[j]), where);
+          dGNorm.add(relDiff(g.f(27 + j / 4, j % 4), v.guideNorm[j]) / (1.0 + kappa - 1.0 / std::expm1(-2.0 * kappa)), where);
+        }
+      }
+      // The pdf and the sampler on the GPU's state: their own arithmetic alone.
+      CasterVertex gv = casterVertexOf(g);
+      float gPdf = pdf[i].f(0), cPdf = diffuseDirectionPdf(gv, scene.params.x, nn, w);
+      dPdf.add(pdfDifference(gv, scene.params.x, nn, w, gPdf), [&] { return str(in[i]) + ": " + str(gPdf) + " vs " + str(cPdf); });
+      glm::vec2 us(arg(in[i], 3));
+      glm::vec3 cDir = sampleDiffuseDirection(gv, scene.params.x, nn, uPick, us);
+      dDir.add(absDiff(dir[i].v(0), cDir) - lobeSpread(gv, scene.params.x, nn, uPick, us, cDir),
+               [&] { return str(in[i]) + ": " + str(dir[i].v(0)) + " vs " + str(cDir); });
+      if (gv.usable > 0 && uPick < scene.params.x) {
+        float pick = uPick / scene.params.x;
+        std::uint32_t j = kGuideClasses * gv.pick;
+        lobeSamples += pick < gv.guideWeight[j] + gv.guideWeight[j + 1];
+      }
+    }
+    mUsable.check();
+    dAxis.check();
+    dOmc.check();
+    dInv.check();
+    dGAxis.check();
+    dGKappa.check();
+    dGNorm.check();
+    dGWeight.check();
+    dPdf.check();
+    dDir.check();
+    // The inputs reach the lobes: prepared, and sampled from.
+    CHECK(lobesPrepared > static_cast<int>(n));
+    CHECK(lobeSamples > static_cast<int>(n) / 20);
+    if (reportWanted()) MESSAGE(lobesPrepared, " lobes prepared; ", lobeSamples, " records sample a lobe");
   }
 }
 

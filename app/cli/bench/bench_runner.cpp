@@ -173,6 +173,7 @@ class BenchRunner {
         run.dispersion = mode;
         run.integrator = integrator.integrator;
         run.manifold = integrator.manifold;
+        if (integrator.unguided) run.guideProbability = 0.0f;
         renderer.apply(run);
         results.push_back(measure(renderer, name, ref, caustic, false));
         if (std::find(adaptiveIntegrators_.begin(), adaptiveIntegrators_.end(), integrator) !=
@@ -384,18 +385,23 @@ class BenchRunner {
   BenchSetup setup_;  // GL renderer, backend and --max-seconds
   int referenceSpp_ = kDefaultReferenceSpp;
   std::string outDir_, cacheDir_;
-  // An estimator of --integrators: naive, mis (manifold NEE as --manifold says, default auto), mis-off
-  // (without manifold NEE) or manifold (mis with --manifold on).
+  // An estimator of --integrators: naive, mis (manifold NEE as --manifold says, default auto; caster
+  // guiding as --guide-probability says, default on), mis-off (without manifold NEE), manifold (mis with
+  // --manifold on) or mis-unguided (mis with --guide-probability 0).
   struct Estimator {
     Integrator integrator;
     ManifoldMode manifold;
-    bool operator==(const Estimator& o) const { return integrator == o.integrator && manifold == o.manifold; }
+    bool unguided = false;
+    bool operator==(const Estimator& o) const {
+      return integrator == o.integrator && manifold == o.manifold && unguided == o.unguided;
+    }
   };
   Estimator parseEstimator(const std::string& name) const {
+    const ManifoldMode asAsked = parseManifoldMode(opts_.get("--manifold", manifoldModeName(RenderSettings{}.manifold)));
     if (name == "manifold") return {Integrator::Mis, ManifoldMode::On};
     if (name == "mis-off") return {Integrator::Mis, ManifoldMode::Off};
-    Integrator i = parseIntegrator(name);
-    return {i, parseManifoldMode(opts_.get("--manifold", manifoldModeName(RenderSettings{}.manifold)))};
+    if (name == "mis-unguided") return {Integrator::Mis, asAsked, true};
+    return {parseIntegrator(name), asAsked};
   }
   std::vector<Estimator> integrators_, adaptiveIntegrators_;
   std::vector<DispersionMode> dispersions_;

@@ -25,6 +25,7 @@ RenderSettings referenceSettings(const RenderSettings& measured, DispersionMode 
   // The reference is one estimate of the image whatever the measured runs use: always mis with the
   // default caster probability, so --caster-probability runs (ablations) share the cached reference.
   rs.casterProbability = RenderSettings{}.casterProbability;
+  rs.guideProbability = RenderSettings{}.guideProbability;
   rs.manifold = ManifoldMode::Off;  // and without manifold NEE: one estimator's reference for all
   return rs;
 }

@@ -62,6 +62,9 @@ std::string estimatorName(const RenderSettings& settings, bool sceneHasCasters) 
     name += formatDouble(" casters=%g", settings.casterProbability);
   if (settings.integrator == Integrator::Mis && sceneHasCasters && settings.manifold != RenderSettings{}.manifold)
     name += std::string(" manifold=") + manifoldModeName(settings.manifold);
+  if (settings.integrator == Integrator::Mis && sceneHasCasters &&
+      settings.guideProbability != RenderSettings{}.guideProbability)
+    name += formatDouble(" guide=%g", settings.guideProbability);
   return name;
 }
 
