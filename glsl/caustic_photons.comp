@@ -1,7 +1,7 @@
-// caustic_photons.comp — the caustic photon pass of manifold NEE: photons leave the emitters towards
-// each caster, follow its specular chain (a glass caster: in and out; a mirror caster: one reflection)
-// and land on a diffuse surface, where each adds itself and its direction back towards the caster to
-// its cell of the caustic cell table (caustic_cells.glsl). Integer atomics only, and a key's slot is
+// caustic_photons.comp — the caustic photon passes: photons leave the emitters towards each caster,
+// follow its specular chain (manifold NEE's table: a glass caster in and out, a mirror caster one
+// reflection; caster guiding's: any chain of smooth events) and land on a diffuse surface, where each
+// adds itself and its direction back towards the last event to its cell of the table (caustic_cells.glsl). Integer atomics only, and a key's slot is
 // found by compare-and-swap in a fixed order of 8 slots, so the table holds the same cells and sums
 // whatever order the photons run in, as long as no photon is dropped (app/gpu/caustic_cells.h).
 #define CAUSTICA_PHOTON_PASS
@@ -179,9 +179,9 @@ void main() {
   uint index = gl_GlobalInvocationID.x, caster = gl_GlobalInvocationID.y;
   // Casters outside count.w (--manifold auto's choice) get no photons: no cells, so manifold NEE
   // never joins through them and a bounce through them keeps weight 1 (path_manifold.glsl).
-  // The guide table: photons to every caster.
+  // The guide table: photons to the casters of guide.y (guideCasterMask).
   if (index >= photons || caster >= casters.count.x) return;
-  if (table == kTableManifold && (casters.count.w & (1u << caster)) == 0u) return;
+  if (((table == kTableManifold ? casters.count.w : casters.guide.y) & (1u << caster)) == 0u) return;
   vec3 landing, back;
   uint owner = caster, cls = 0u;
   if (!(table == kTableGuide ? traceGuidePhoton(caster, index, landing, back, owner, cls)

@@ -124,7 +124,8 @@ std::vector<OptionSpec> sceneOptionSpecs() {
        "mis: chance that a diffuse bounce aims at a glass or mirror object (0 to 0.9, default 0.5; 0 = off)"},
       {"--guide-probability", "", "P",
        "mis: chance that a bounce aimed at a glass or mirror object follows the direction its caustic photons "
-       "came from near the vertex (caster guiding; 0 to 1, default 0.5; 0 = off)"},
+       "came from near the vertex (caster guiding, for the objects the lights look small from, as --manifold auto "
+       "picks them; 0 to 1, default 0.5; 0 = off)"},
       {"--manifold", "", "auto|on|off",
        "mis: manifold next-event estimation, light joined to diffuse points through glass and mirror objects "
        "(caustics of small lights); auto (default) uses it through the objects the lights look small from "

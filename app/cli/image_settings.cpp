@@ -181,8 +181,7 @@ std::string identityWithoutSceneLines(const std::string& identity) {
 }
 
 float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {
-  const bool guides = s.integrator == Integrator::Mis && s.casterProbability > 0.0f && !gpu.casters.empty() &&
-                      gpu.emitterCount > 0;
+  const bool guides = s.integrator == Integrator::Mis && s.casterProbability > 0.0f && guideCasterMask(gpu) != 0u;
   return guides ? s.guideProbability : 0.0f;
 }
 

@@ -111,7 +111,8 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& ca
 // takes (the same variant and photon cells), and stays Auto where it takes some casters only (an image
 // neither On nor Off renders). On and Off stay as given.
 // --guide-probability as the image sees it: 0 where caster guiding is not compiled (naive, no caster
-// aiming, no caster or no emissive triangle), so that such renders continue and merge whatever it says.
+// aiming, no caster the emitters look small from: guideCasterMask), so that such renders continue and
+// merge whatever it says.
 float imageGuideProbability(const RenderSettings& settings, const GpuScene& gpu);
 ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // An identity text with its manifold line replaced by imageManifoldMode for `gpu` (a text without one

@@ -34,8 +34,8 @@ std::vector<glm::uvec2> photonEmitterTable(const LightTree& tree, const gpu::Cas
 
 // Which table a photon pass fills (caustic_photons.comp's `table`): manifold NEE's (photons to the
 // casters of cp.count.w along their own chain; bucket mask in cp.count.z, CAUSTICA_TEXUNIT_CELL_*)
-// or caster guiding's (photons to every caster along any chain of smooth events, counted for the caster
-// of their last event; bucket mask in cp.guide.x, CAUSTICA_TEXUNIT_GUIDE_*).
+// or caster guiding's (photons to the casters of cp.guide.y along any chain of smooth events, counted for
+// the caster of their last event; bucket mask in cp.guide.x, CAUSTICA_TEXUNIT_GUIDE_*).
 enum class CellTable : std::uint32_t { Manifold = 0, Guide = 1 };
 
 // Buckets (of 4 slots) of a first table for `casters` casters: a power of 2 with room for every
@@ -57,8 +57,7 @@ class CausticCells {
   // The photons leave from emitters drawn from `tree`'s photonEmitterTable.
   template <class Upload>
   void build(const GlProgram& program, const LightTree& tree, gpu::CasterParams& cp, Upload&& upload) {
-    const std::uint32_t all = cp.count.x >= 32u ? ~0u : (1u << cp.count.x) - 1u;
-    const std::vector<glm::uvec2> emitters = photonEmitterTable(tree, cp, table_ == CellTable::Guide ? all : cp.count.w);
+    const std::vector<glm::uvec2> emitters = photonEmitterTable(tree, cp, table_ == CellTable::Guide ? cp.guide.y : cp.count.w);
     const GlBuffer emitterBuffer = emitters.empty() ? GlBuffer() : GlBuffer::fromVector(emitters);
     const auto entries = static_cast<std::uint32_t>(emitters.size() / std::max<std::uint32_t>(cp.count.x, 1u));
     std::uint32_t& mask = table_ == CellTable::Guide ? cp.guide.x : cp.count.z;

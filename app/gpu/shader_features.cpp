@@ -102,8 +102,9 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
       {"guiding", "CAUSTICA_GUIDING", K::Integrator,
        "caster guiding: aimed bounces follow a direction lobe fitted to the caustic photons of a guide photon "
        "pass (glsl/lib/casters.glsl), at every diffuse vertex whose cell they reached",
-       "casters, an emissive triangle and --guide-probability > 0", nullptr,
-       [](const SceneView& v) { return !v.gpu.casters.empty() && v.gpu.emitterCount > 0; },
+       "casters, --guide-probability > 0 and a smooth caster the emitters look small from (as --manifold auto "
+       "chooses: guideCasterMask)", nullptr,
+       [](const SceneView& v) { return guideCasterMask(v.gpu) != 0u; },
        [](const RenderSettings& s) { return s.guideProbability > 0.0f; }, "CAUSTICA_CASTERS", A::Keep},
       {"manifold", "CAUSTICA_MANIFOLD", K::Integrator,
        "manifold next-event estimation: light joined to the first diffuse vertex through one glass or mirror "
@@ -209,6 +210,8 @@ std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g) {
     if (m == ManifoldMode::On || (m == ManifoldMode::Auto && g.casters[i].manifoldAuto)) mask |= 1u << i;
   return g.emitterCount > 0 ? mask : 0u;
 }
+
+std::uint32_t guideCasterMask(const GpuScene& g) { return manifoldCasterMask(ManifoldMode::Auto, g); }
 
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g) {
   if (s.manifold == ManifoldMode::Auto)

@@ -94,6 +94,10 @@ std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g);
 // caster, else Off (the manifold row's settings test reads On; a scene where auto finds no caster
 // compiles the same variant as off). What the Renderer asks variantFeatures with.
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g);
+// The casters caster guiding sends its photons to: those --manifold auto chooses (smooth, the emitters
+// subtending less than kManifoldAutoSolidAngle from them), where guiding measured a gain; under larger
+// lamps it measured a loss (docs/path-tracer.md). 0: guiding is not compiled.
+std::uint32_t guideCasterMask(const GpuScene& g);
 // Every row the mode's entry shader can read (what the shader tests compile combinations of).
 FeatureSet modeFeatureRows(RenderMode mode);
 

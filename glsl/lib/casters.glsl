@@ -1,5 +1,6 @@
 // casters.glsl — diffuse bounce directions aimed at caustic casters (bounding spheres of glass and
-// mirror objects, CasterParams in gpu_layout.h) mixed with cosine sampling. Twins in app/shading/sampling.h.
+// mirror objects, CasterParams in gpu_layout.h) and, with caster guiding, at vMF lobes fitted to their
+// caustic photons, mixed with cosine sampling. Twins in app/shading/sampling.h.
 // Directions are world-space unit vectors; pdfs are per steradian.
 
 layout(std140, binding = CAUSTICA_BINDING_CASTERS) uniform CasterBlock { CasterParams casters; };

@@ -1,7 +1,8 @@
 // caustic_cells.glsl — the caustic cell table (CausticCell in gpu_layout.h): for each caster, the cells
 // (cubes of kCellPerRadius times its radius) that its caustic photons reached (caustic_photons.comp),
 // with their count and the direction they came from. Manifold NEE joins light through a caster only
-// from its cells and starts its Newton steps from the cell's direction (path_manifold.glsl). A hash
+// from its cells and starts its Newton steps from the cell's direction (path_manifold.glsl); caster
+// guiding's table (the same layout, keyed also by photon class) gives its lobes (casters.glsl). A hash
 // table of buckets of 4 keys; a key lives in one of two buckets, so a lookup reads two buckets and one
 // slot, without a loop. Needs rng.glsl (pcg4d) and casters.glsl (the CasterParams block).
 
