@@ -182,8 +182,8 @@ std::string checkpointMismatch(const Checkpoint& ck, std::uint64_t sceneHash, co
                                const GpuScene* gpu) {
   Checkpoint resolved;
   resolved.sceneHash = ck.sceneHash;
-  resolved.identity = gpu ? resolveIdentityManifold(ck.identity, *gpu) : identityWithoutSceneLines(ck.identity);
-  return checkpointMismatch(resolved, sceneHash, gpu ? resolveIdentityManifold(identity, *gpu) : identityWithoutSceneLines(identity));
+  resolved.identity = gpu ? resolveIdentityScene(ck.identity, *gpu) : identityWithoutSceneLines(ck.identity);
+  return checkpointMismatch(resolved, sceneHash, gpu ? resolveIdentityScene(identity, *gpu) : identityWithoutSceneLines(identity));
 }
 
 }  // namespace caustica::cli

@@ -172,6 +172,17 @@ std::string resolveIdentityManifold(const std::string& identity, const GpuScene&
   });
 }
 
+std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu) {
+  std::string out;
+  std::istringstream in(resolveIdentityManifold(identity, gpu));
+  for (std::string line; std::getline(in, line);) {
+    // Guiding is not compiled without a caster it applies to: any guide probability renders as 0.
+    if (line.rfind("guide-probability ", 0) == 0 && guideCasterMask(gpu) == 0u) line = "guide-probability 0";
+    out += line + '\n';
+  }
+  return out;
+}
+
 std::string identityWithoutSceneLines(const std::string& identity) {
   std::string out;
   std::istringstream in(identity);

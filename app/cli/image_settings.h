@@ -119,6 +119,9 @@ ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
 // "manifold auto" literally reads as what auto gives for the scene.
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
+// resolveIdentityManifold, and the guide-probability line as 0 where guiding is not compiled for the
+// scene (no caster it applies to, imageGuideProbability): what resuming compares once the scene is packed.
+std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu);
 // The identity text without its manifold and guide-probability lines (what they mean depends on the
 // scene: imageManifoldMode, imageGuideProbability): what can be compared before the scene is packed.
 std::string identityWithoutSceneLines(const std::string& identity);
