@@ -1,9 +1,10 @@
 // caustic_photons.comp — the caustic photon passes: photons leave the emitters towards each caster,
 // follow its specular chain (manifold NEE's table: a glass caster in and out, a mirror caster one
 // reflection; caster guiding's: any chain of smooth events) and land on a diffuse surface, where each
-// adds itself and its direction back towards the last event to its cell of the table (caustic_cells.glsl). Integer atomics only, and a key's slot is
-// found by compare-and-swap in a fixed order of 8 slots, so the table holds the same cells and sums
-// whatever order the photons run in, as long as no photon is dropped (app/gpu/caustic_cells.h).
+// adds itself and its direction back towards the last event to its cell of the table (caustic_cells.glsl).
+// Integer atomics only, and a key's slot is found by compare-and-swap in a fixed order of 8 slots, so the
+// table holds the same cells and sums whatever order the photons run in, as long as no photon is dropped
+// (app/gpu/caustic_cells.h).
 #define CAUSTICA_PHOTON_PASS
 #include "lib/bindings.glsl"
 #include "lib/rng.glsl"
@@ -62,11 +63,11 @@ bool samplePhotonEmitter(uint caster, vec3 centre, float u, vec2 uTri, out Light
   return sampleLightTriangle(centre, link.x, 1.0, uTri, ls);
 }
 
-// Follows photon `index` of caster `caster` from an emitter through the caster's chain to a diffuse
-// surface: its landing point and the unit direction from there back to the chain's last vertex.
-bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
-  landing = back = vec3(0.0);
-  uvec4 rng = rngSeed(index, caster, 0x9e3779b9u);
+// Where photon rng leaves for caster `caster`: a point on an emitter (samplePhotonEmitter; `from`) and a
+// uniform direction in the cone of the caster's sphere (dir), its ray starting at org. False when the
+// emitter faces away or the point lies inside the sphere.
+bool launchPhoton(uint caster, inout uvec4 rng, out vec3 from, out vec3 org, out vec3 dir) {
+  from = org = dir = vec3(0.0);
   vec4 sphere = casters.sphere[caster];
   LightSample ls;
   if (!samplePhotonEmitter(caster, sphere.xyz, rand01(rng), rand2(rng), ls)) return false;
@@ -74,13 +75,24 @@ bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
   float omc;
   vec3 facing = ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n;
   if (!casterCone(ls.p, facing, sphere, axis, omc)) return false;
-  vec3 dir = sampleUniformCone(axis, omc, rand2(rng));
+  dir = sampleUniformCone(axis, omc, rand2(rng));
   float side = dot(dir, ls.n);
   if (!(side > 0.0 || ls.twoSided)) return false;
-  vec3 org = offsetRayOrigin(ls.p, ls.pError, side > 0.0 ? ls.n : -ls.n);
+  from = ls.p;
+  org = offsetRayOrigin(ls.p, ls.pError, side > 0.0 ? ls.n : -ls.n);
+  return true;
+}
+
+// Follows photon `index` of caster `caster` from an emitter through the caster's chain to a diffuse
+// surface: its landing point and the unit direction from there back to the chain's last vertex.
+bool tracePhoton(uint caster, uint index, out vec3 landing, out vec3 back) {
+  landing = back = vec3(0.0);
+  uvec4 rng = rngSeed(index, caster, 0x9e3779b9u);
+  vec4 sphere = casters.sphere[caster];
+  vec3 last, org, dir;
+  if (!launchPhoton(caster, rng, last, org, dir)) return false;
   bool refractive = (casters.count.y & (1u << caster)) != 0u;
   uint events = refractive ? 2u : 1u;
-  vec3 last = ls.p;
   for (uint k = 0u; k <= events; ++k) {
     Hit hit;
     if (!traceClosest(org, dir, 3.0e38, hit)) return false;
@@ -126,18 +138,8 @@ bool traceGuidePhoton(uint caster, uint index, out vec3 landing, out vec3 back, 
   bool refractive = (casters.count.y & (1u << caster)) != 0u;
   bool own = true;  // every event so far on the caster, refracted (glass) or reflected (mirror)
   uvec4 rng = rngSeed(index, caster, 0x7f4a7c15u);
-  vec4 sphere = casters.sphere[caster];
-  LightSample ls;
-  if (!samplePhotonEmitter(caster, sphere.xyz, rand01(rng), rand2(rng), ls)) return false;
-  vec3 axis;
-  float omc;
-  vec3 facing = ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n;
-  if (!casterCone(ls.p, facing, sphere, axis, omc)) return false;
-  vec3 dir = sampleUniformCone(axis, omc, rand2(rng));
-  float side = dot(dir, ls.n);
-  if (!(side > 0.0 || ls.twoSided)) return false;
-  vec3 org = offsetRayOrigin(ls.p, ls.pError, side > 0.0 ? ls.n : -ls.n);
-  vec3 lastP = ls.p;
+  vec3 lastP, org, dir;
+  if (!launchPhoton(caster, rng, lastP, org, dir)) return false;
   for (uint k = 0u; k <= kMaxGuideEvents; ++k) {
     Hit hit;
     if (!traceClosest(org, dir, 3.0e38, hit)) return false;

@@ -142,18 +142,19 @@ ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu) {
 
 namespace {
 
-// `identity` with its "manifold MODE" line given to `edit`, which returns the line's replacement
-// ("" drops it); a text without that line comes back unchanged.
+// `identity` with each line whose key is `key` given to `edit` (with the value after "KEY "), which
+// returns the line's replacement without its newline, or "" to drop it; other lines unchanged.
 template <class Edit>
-std::string editManifoldLine(const std::string& identity, Edit&& edit) {
-  static const std::string key = "manifold ";
+std::string editIdentityLines(const std::string& identity, const std::string& key, Edit&& edit) {
+  const std::string prefix = key + ' ';
   std::string out;
   std::istringstream in(identity);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.compare(0, key.size(), key) == 0) line = edit(line.substr(key.size()));
-    else line += '\n';
-    out += line;
+  for (std::string line; std::getline(in, line);) {
+    if (line.compare(0, prefix.size(), prefix) == 0) {
+      line = edit(line.substr(prefix.size()));
+      if (line.empty()) continue;
+    }
+    out += line + '\n';
   }
   return out;
 }
@@ -161,34 +162,27 @@ std::string editManifoldLine(const std::string& identity, Edit&& edit) {
 }  // namespace
 
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu) {
-  return editManifoldLine(identity, [&](const std::string& mode) {
+  return editIdentityLines(identity, "manifold", [&](const std::string& mode) {
     ManifoldMode m;
     try {
       m = parseManifoldMode(mode);
     } catch (const Error&) {
-      return "manifold " + mode + "\n";  // not a mode this build knows: compared as it is (and differs)
+      return "manifold " + mode;  // not a mode this build knows: compared as it is (and differs)
     }
-    return std::string("manifold ") + manifoldModeName(imageManifoldMode(m, gpu)) + "\n";
+    return std::string("manifold ") + manifoldModeName(imageManifoldMode(m, gpu));
   });
 }
 
 std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu) {
-  std::string out;
-  std::istringstream in(resolveIdentityManifold(identity, gpu));
-  for (std::string line; std::getline(in, line);) {
-    // Guiding is not compiled without a caster it applies to: any guide probability renders as 0.
-    if (line.rfind("guide-probability ", 0) == 0 && guideCasterMask(gpu) == 0u) line = "guide-probability 0";
-    out += line + '\n';
-  }
-  return out;
+  // Guiding is not compiled without a caster it applies to: any guide probability renders as 0.
+  return editIdentityLines(resolveIdentityManifold(identity, gpu), "guide-probability", [&](const std::string& p) {
+    return "guide-probability " + (guideCasterMask(gpu) == 0u ? std::string("0") : p);
+  });
 }
 
 std::string identityWithoutSceneLines(const std::string& identity) {
-  std::string out;
-  std::istringstream in(identity);
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("manifold ", 0) != 0 && line.rfind("guide-probability ", 0) != 0) out += line + '\n';
-  return out;
+  const auto drop = [](const std::string&) { return std::string(); };
+  return editIdentityLines(editIdentityLines(identity, "manifold", drop), "guide-probability", drop);
 }
 
 float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {

@@ -102,7 +102,8 @@ std::string settingsSummary(const ImageSettings& settings);
 // (cli/checkpoint.h); compare two with identityDifference.
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera);
 // The accumulation identity of a render of the scene packed as `gpu` (Renderer::gpuScene): as above,
-// with the manifold line as the image sees it (imageManifoldMode). What checkpoints and shard partials
+// with the manifold and guide-probability lines as the image sees them (imageManifoldMode,
+// imageGuideProbability). What checkpoints and shard partials
 // record and resuming compares, so that `--manifold auto` on a scene where auto finds no caster
 // continues a `--manifold off` render and the other way round.
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu);
@@ -110,11 +111,11 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& ca
 // sends photons to no caster (resolveManifold: the off variant), On where it takes every caster On
 // takes (the same variant and photon cells), and stays Auto where it takes some casters only (an image
 // neither On nor Off renders). On and Off stay as given.
+ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // --guide-probability as the image sees it: 0 where caster guiding is not compiled (naive, no caster
 // aiming, no caster the emitters look small from: guideCasterMask), so that such renders continue and
 // merge whatever it says.
 float imageGuideProbability(const RenderSettings& settings, const GpuScene& gpu);
-ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // An identity text with its manifold line replaced by imageManifoldMode for `gpu` (a text without one
 // is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
 // "manifold auto" literally reads as what auto gives for the scene.

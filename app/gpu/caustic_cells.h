@@ -52,8 +52,8 @@ class CausticCells {
  public:
   explicit CausticCells(CellTable table = CellTable::Manifold) : table_(table) {}
   // Runs the photon pass with `program` (caustic_photons.comp; the scene's textures, storage blocks and
-  // UBOs bound as for a path-tracing dispatch) for the cp.count.x casters of `cp`, whose count.z it sets
-  // to the table's bucket mask; `upload(cp)` puts cp where the shaders read it (called before each try).
+  // UBOs bound as for a path-tracing dispatch) for the cp.count.x casters of `cp`, whose count.z (manifold
+  // NEE's table) or guide.x (caster guiding's) it sets to the table's bucket mask; `upload(cp)` puts cp where the shaders read it (called before each try).
   // The photons leave from emitters drawn from `tree`'s photonEmitterTable.
   template <class Upload>
   void build(const GlProgram& program, const LightTree& tree, gpu::CasterParams& cp, Upload&& upload) {

@@ -277,8 +277,8 @@ std::vector<std::string> Renderer::shaderDefines() const {
 
 const GlProgram& Renderer::program() {
   std::vector<std::string> defines = shaderDefines();
-  // The caustic photon pass, once per scene and set of casters (manifoldCasterMask), before the first
-  // variant with manifold NEE runs.
+  // The caustic photon pass of manifold NEE, once per scene and set of casters (manifoldCasterMask),
+  // before the first variant with manifold NEE runs.
   auto has = [&](const char* d) { return std::find(defines.begin(), defines.end(), d) != defines.end(); };
   if ((!causticCells_.built() || cellCasters_ != manifoldCasterMask(settings_.manifold, gpuScene_)) && has("CAUSTICA_MANIFOLD"))
     buildCausticCells(CellTable::Manifold);
@@ -286,6 +286,10 @@ const GlProgram& Renderer::program() {
   if (!causticGuides_.built() && has("CAUSTICA_GUIDING")) buildCausticCells(CellTable::Guide);
   const char* entry = renderModeSpec(settings_.mode).entryShader;
   if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
+  return compiledProgram(entry, defines);
+}
+
+const GlProgram& Renderer::compiledProgram(const char* entry, const std::vector<std::string>& defines) {
   std::string key = std::string(entry) + ":";
   for (const auto& d : defines) key += d + " ";
   auto it = programs_.find(key);
@@ -356,9 +360,7 @@ void Renderer::buildCausticCells(CellTable table) {
   std::vector<std::string> defines = sceneFeatures_.only(FeatureKind::Scene).defines();  // materials as the scene needs
   for (const std::string& split : bufferLayout_.defines()) defines.push_back(split);
   for (const std::string& inst : gpuScene_.instanceDefines()) defines.push_back(inst);
-  ExpandedShader src = library_.expand("caustic_photons.comp", defines);
-  GlProgram photons =
-      GlProgram::compileCompute(src.source, [&](const std::string& log) { return src.mapLog(log); }, "caustic_photons.comp");
+  const GlProgram& photons = compiledProgram("caustic_photons.comp", defines);  // one program for both tables
   gpu::FrameParams fp{};
   fp.options = glm::uvec4(settings_.maxDepth, 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), 1u);  // lights.glsl reads the emitter count
   frameUbo_.update(0, sizeof fp, &fp);

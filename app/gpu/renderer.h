@@ -191,7 +191,8 @@ class Renderer {
   // current settings need: variantFeatures' rows, then the storage layout's (split blocks, instancing).
   const FeatureSet& sceneFeatures() const { return sceneFeatures_; }
   std::vector<std::string> shaderDefines() const;
-  // The caustic cell table of manifold NEE as its photon pass built it (zero before one ran).
+  // What a caustic cell table holds (manifold NEE's or caster guiding's) as its photon pass built it
+  // (zero before one ran).
   CausticCellStats causticCellStats(CellTable t = CellTable::Manifold) const {
     return (t == CellTable::Guide ? causticGuides_ : causticCells_).stats();
   }
@@ -210,8 +211,10 @@ class Renderer {
   void uploadCasters();
   Image meansOf(const std::vector<float>& rgba) const;  // meanImage of sums like accum_'s, with coverage alpha
   gpu::CasterParams casterParams() const;  // the caster UBO for the current settings and cells
-  // The caustic photon pass (caustic_cells.h), once per scene, before the first manifold NEE variant runs.
+  // A caustic photon pass (caustic_cells.h) filling `table`: manifold NEE's or caster guiding's.
   void buildCausticCells(CellTable table);
+  // The compute program of `entry` with `defines`, compiled once per renderer (programs_).
+  const GlProgram& compiledProgram(const char* entry, const std::vector<std::string>& defines);
   // The constructor's steps, in order; setScene repeats loadScene's.
   void checkLimits();                      // the GL context's limits and the settings
   void loadScene(const Scene& scene);      // the next five: everything of the scene on the GPU

@@ -101,7 +101,7 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        [](const RenderSettings& s) { return s.casterProbability > 0.0f; }, "CAUSTICA_MIS", A::Keep},
       {"guiding", "CAUSTICA_GUIDING", K::Integrator,
        "caster guiding: aimed bounces follow a direction lobe fitted to the caustic photons of a guide photon "
-       "pass (glsl/lib/casters.glsl), at every diffuse vertex whose cell they reached",
+       "pass (glsl/lib/casters.glsl), at the first diffuse vertex where its cell has them",
        "casters, --guide-probability > 0 and a smooth caster the emitters look small from (as --manifold auto "
        "chooses: guideCasterMask)", nullptr,
        [](const SceneView& v) { return guideCasterMask(v.gpu) != 0u; },

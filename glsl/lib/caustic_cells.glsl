@@ -6,13 +6,20 @@
 // table of buckets of 4 keys; a key lives in one of two buckets, so a lookup reads two buckets and one
 // slot, without a loop. Needs rng.glsl (pcg4d) and casters.glsl (the CasterParams block).
 
+// The integer coordinates of the cell of caster `caster` holding p (cubes of kCellPerRadius times its
+// radius), offset by `centreCell` cells so that they count from 0; false outside [0, 2 centreCell) (no key).
+bool casterCellCoords(uint caster, vec3 p, vec3 centreCell, out uvec3 u) {
+  vec4 sphere = casters.sphere[caster];
+  vec3 c = floor((p - sphere.xyz) / (kCellPerRadius * sphere.w)) + centreCell;
+  u = uvec3(max(c, vec3(0.0)));
+  return !(any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, 2.0 * centreCell)));
+}
+
 // The key of the cell of caster `caster` holding p: 3 bits of caster, 10 + 9 + 10 bits of the cell's
 // coordinates about the caster's centre (x, z within +-512 cells, y within +-256); 0 (no key) outside.
 uint casterCellKey(uint caster, vec3 p) {
-  vec4 sphere = casters.sphere[caster];
-  vec3 c = floor((p - sphere.xyz) / (kCellPerRadius * sphere.w)) + vec3(512.0, 256.0, 512.0);
-  if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(1024.0, 512.0, 1024.0)))) return 0u;
-  uvec3 u = uvec3(c);
+  uvec3 u;
+  if (!casterCellCoords(caster, p, vec3(512.0, 256.0, 512.0), u)) return 0u;
   return caster << 29 | u.x << 19 | u.y << 10 | u.z;
 }
 
@@ -20,10 +27,8 @@ uint casterCellKey(uint caster, vec3 p) {
 // caster's own chain, 1: any other; caustic_photons.comp): 3 bits of caster, 1 of class, 10 + 8 + 10 bits
 // of the cell's coordinates about the caster's centre (x, z within +-512 cells, y within +-128); 0 outside.
 uint guideCellKey(uint caster, uint cls, vec3 p) {
-  vec4 sphere = casters.sphere[caster];
-  vec3 c = floor((p - sphere.xyz) / (kCellPerRadius * sphere.w)) + vec3(512.0, 128.0, 512.0);
-  if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(1024.0, 256.0, 1024.0)))) return 0u;
-  uvec3 u = uvec3(c);
+  uvec3 u;
+  if (!casterCellCoords(caster, p, vec3(512.0, 128.0, 512.0), u)) return 0u;
   return caster << 29 | cls << 28 | u.x << 18 | u.y << 10 | u.z;
 }
 
