@@ -150,10 +150,12 @@ void printFeatures(const Scene& s, const GpuScene& g) {
   const FeatureSet features = detectFeatures(s, g).only(FeatureKind::Scene);  // shader_features.cpp
   std::printf("features:   %s\n", features.describe().c_str());
   if (g.casters.empty()) std::printf("casters:    none (no glass or mirror object)\n");
+  const std::uint32_t aimed = aimCasterMask(g);
   for (size_t i = 0; i < g.casters.size(); ++i)
-    std::printf("%s %s sphere at %s, radius %.3g; emitters subtend %.3g sr: manifold auto %s\n",
+    std::printf("%s %s sphere at %s, radius %.3g; emitters subtend %.3g sr: %s, manifold auto %s\n",
                 i == 0 ? "casters:   " : "           ", g.casters[i].refractive ? "glass " : "mirror",
                 vec(glm::vec3(g.casters[i].sphere)).c_str(), g.casters[i].sphere.w, g.casters[i].emitterSolidAngle,
+                (aimed & (1u << i)) != 0u ? "aimed at" : "not aimed at",
                 g.casters[i].manifoldAuto ? "on" : !g.casters[i].smooth ? "off (rough)" : "off");
   std::string defines;
   for (const auto& d : features.defines()) defines += " " + d;

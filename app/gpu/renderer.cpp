@@ -386,6 +386,7 @@ gpu::CasterParams Renderer::casterParams() const {
   cp.count.z = cellTableMask_;
   cp.guide.x = guideTableMask_;
   cp.guide.y = guideCasterMask(gpuScene_);  // the guide photon pass's casters
+  cp.guide.z = aimCasterMask(gpuScene_);    // the casters a bounce aims at
   cp.count.w = manifoldCasterMask(settings_.manifold, gpuScene_);  // the photon pass's casters
   cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
   cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, settings_.guideProbability, 0.0f);

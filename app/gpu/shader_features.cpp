@@ -96,8 +96,9 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        "--integrator mis and an emitter or an environment map", nullptr, misHasLights,
        [](const RenderSettings& s) { return s.integrator == Integrator::Mis; }, nullptr, A::Keep},
       {"casters", "CAUSTICA_CASTERS", K::Integrator, "diffuse bounces also aim at glass and mirror objects",
-       "mis, a caustic caster and --caster-probability > 0", nullptr,
-       [](const SceneView& v) { return !v.gpu.casters.empty(); },
+       "mis, a caustic caster to aim at (aimCasterMask: glass, or a mirror the emitters look small from) and "
+       "--caster-probability > 0", nullptr,
+       [](const SceneView& v) { return aimCasterMask(v.gpu) != 0u; },
        [](const RenderSettings& s) { return s.casterProbability > 0.0f; }, "CAUSTICA_MIS", A::Keep},
       {"guiding", "CAUSTICA_GUIDING", K::Integrator,
        "caster guiding: aimed bounces follow a direction lobe fitted to the caustic photons of a guide photon "
@@ -212,6 +213,13 @@ std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g) {
 }
 
 std::uint32_t guideCasterMask(const GpuScene& g) { return manifoldCasterMask(ManifoldMode::Auto, g); }
+
+std::uint32_t aimCasterMask(const GpuScene& g) {
+  std::uint32_t mask = guideCasterMask(g);
+  for (std::size_t i = 0; i < g.casters.size() && i < CAUSTICA_MAX_CASTERS; ++i)
+    if (g.casters[i].refractive) mask |= 1u << i;
+  return mask;
+}
 
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g) {
   if (s.manifold == ManifoldMode::Auto)

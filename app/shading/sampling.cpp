@@ -150,12 +150,12 @@ float guidePdf(const CasterVertex& v, std::uint32_t j, const glm::vec3& w) {
 
 CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
                             std::uint32_t refractMask, const glm::vec4& lights, float margin,
-                            const glm::uvec4* guideCells, float guideProbability) {
+                            const glm::uvec4* guideCells, float guideProbability, std::uint32_t aimMask) {
   CasterVertex v;
   for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(CasterVertex::kMax) && i < count; ++i) {
     glm::vec3 axis;
     float omc;
-    bool cone = casterCone(p, n, spheres[i], axis, omc) &&
+    bool cone = (aimMask & (1u << i)) != 0u && casterCone(p, n, spheres[i], axis, omc) &&
                 ((refractMask & (1u << i)) == 0u || casterFacesLights(p, axis, omc, lights, margin));
     glm::vec3 gAxis[kGuideClasses];
     float kappa[kGuideClasses];

@@ -60,9 +60,11 @@ bool casterFacesLights(const glm::vec3& p, const glm::vec3& axis, float oneMinus
 // refractMask bit i: spheres[i] refracts and is used only where casterFacesLights. guideCells: with caster
 // guiding, the guide cells at p, kGuideClasses per caster (at [kGuideClasses * i + class]), and
 // guideProbability the lobes' share of an aimed bounce where the caster's cone is usable; nullptr without.
+// aimMask bit i: spheres[i]'s cone may be aimed at at all (aimCasterMask); its guide lobes count regardless.
 CasterVertex prepareCasters(const glm::vec3& p, const glm::vec3& n, float u, const glm::vec4* spheres, std::uint32_t count,
                             std::uint32_t refractMask, const glm::vec4& lights, float margin,
-                            const glm::uvec4* guideCells = nullptr, float guideProbability = 0.0f);
+                            const glm::uvec4* guideCells = nullptr, float guideProbability = 0.0f,
+                            std::uint32_t aimMask = ~0u);
 float diffuseDirectionPdf(const CasterVertex& v, float casterProbability, const glm::vec3& n, const glm::vec3& w);
 glm::vec3 sampleDiffuseDirection(const CasterVertex& v, float casterProbability, const glm::vec3& n, float uPick,
                                  const glm::vec2& u);

@@ -138,7 +138,7 @@ void prepareCasters(vec3 p, vec3 n, float u) {
     if (i >= casters.count.x) break;
     vec3 axis;
     float omc;
-    bool cone = casterCone(p, n, casters.sphere[i], axis, omc) &&
+    bool cone = (casters.guide.z & (1u << i)) != 0u && casterCone(p, n, casters.sphere[i], axis, omc) &&
                 ((casters.count.y & (1u << i)) == 0u || casterFacesLights(p, axis, omc, casters.lights, casters.params.y));
 #ifdef CAUSTICA_GUIDING
     vec3 gAxis[kGuideClasses];

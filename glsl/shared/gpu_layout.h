@@ -292,7 +292,8 @@ struct CasterParams {
                                           // photons to sphere i (manifoldCasterMask; caustic_photons.comp only)
   uvec4 guide;                            // x: buckets of the caster guide table - 1 (caster guiding, caustic_cells.glsl),
                                           // 0: no table; y: bit i set = the guide photon pass sends photons to
-                                          // sphere i (guideCasterMask; caustic_photons.comp only); zw unused
+                                          // sphere i (guideCasterMask; caustic_photons.comp only); z: bit i set = a
+                                          // diffuse bounce may aim at sphere i's cone (aimCasterMask); w unused
   vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians);
                                           // z: probability that an aimed bounce follows a caster's guide lobe; w unused
   vec4 lights;                            // xyz: centre, w: radius of a sphere around every emitter (world space)

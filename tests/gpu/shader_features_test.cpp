@@ -218,6 +218,31 @@ TEST_CASE("shader features: detection from the materials some triangle uses and 
   CHECK(detect(s).describe() == "glass dispersion textures opacity environment punctual spot-emitters ggx");
 }
 
+TEST_CASE("shader features: caster aiming takes glass, and a mirror only where the emitters look small from it") {
+  // aimCasterMask: under a large lamp a mirror's reflection of it is found by cosine sampling about as often
+  // as by aiming at the mirror's cone (docs/path-tracer.md), so a scene whose only caster is such a mirror
+  // does not compile caster aiming; under a small lamp the mirror is guided and aimed at.
+  Material mirror, light;
+  mirror.metallic = 1.0f;
+  light.emission = glm::vec3(4.0f);
+  for (float lamp : {1.0f, 0.01f}) {
+    CAPTURE(lamp);
+    Scene s;
+    s.materials = {mirror, light};
+    addSquare(s, 1.0f, 0, 0.1f);   // the mirror, above
+    addSquare(s, 0.0f, 1, lamp);   // the lamp, facing up at it
+    const GpuScene g = packScene(s, buildBvh(s.triangles));
+    REQUIRE(g.casters.size() == 1);
+    CHECK(aimCasterMask(g) == (lamp < 0.1f ? 1u : 0u));
+    CHECK(detectFeatures(s, g).has("CAUSTICA_CASTERS") == (lamp < 0.1f));
+    s.materials[0].transmission = 1.0f;  // glass instead: aimed at under either lamp
+    s.materials[0].metallic = 0.0f;
+    const GpuScene glass = packScene(s, buildBvh(s.triangles));
+    CHECK(aimCasterMask(glass) == 1u);
+    CHECK(detectFeatures(s, glass).has("CAUSTICA_CASTERS"));
+  }
+}
+
 // The layers cost nothing where no triangle uses them: a coat, a sheen or a factor texture switches
 // its row on only through a material some triangle has (the shader reads the layer texels only then).
 TEST_CASE("shader features: clear coat, sheen and factor textures only from a material some triangle uses") {

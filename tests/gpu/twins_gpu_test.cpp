@@ -721,9 +721,10 @@ namespace {
 // A CasterParams block: `count` random spheres (refractive where refractMask has the bit), the lights'
 // bounding sphere, the probability of aiming at a caster and the margin.
 gpu::CasterParams casterScene(Random& r, std::uint32_t count, std::uint32_t refractMask, const glm::vec4& lights,
-                              float probability, float margin) {
+                              float probability, float margin, std::uint32_t aimMask = 0xffu) {
   gpu::CasterParams c{};
   c.count = glm::uvec4(count, refractMask, 0, 0);
+  c.guide.z = aimMask;  // the casters a bounce may aim at (aimCasterMask)
   c.params = glm::vec4(probability, margin, 0, 0);
   c.lights = lights;
   for (std::uint32_t i = 0; i < count; ++i) c.sphere[i] = glm::vec4(r.inBox(2.0f), r.logUniform(0.02f, 0.6f));
@@ -739,7 +740,7 @@ CasterVertex prepareCasters(const gpu::CasterParams& c, const glm::vec3& p, cons
   for (int i = 0; i < CasterVertex::kMax; ++i)
     spheres[i] = glm::vec4(glm::vec3(c.sphere[i]), c.sphere[i].w * radiusScale);
   return caustica::prepareCasters(p, n, u, spheres, c.count.x, c.count.y, c.lights, c.params.y + marginShift,
-                                  guideCells, c.params.z);
+                                  guideCells, c.params.z, c.guide.z);
 }
 
 // The GPU's diffuseDirectionPdf gPdf against the C++ twin's on caster state v: relative where the caster
@@ -764,6 +765,7 @@ TEST_CASE("GLSL caster state equals its C++ twin: prepareCasters, diffuseDirecti
   const size_t n = 4096;
   const gpu::CasterParams scenes[] = {
       casterScene(r, 8, 0xa5u, glm::vec4(0.0f, 2.5f, 0.0f, 1.0f), 0.3f, 0.1f),  // every slot, some refractive
+      casterScene(r, 8, 0xa5u, glm::vec4(0.0f, 2.5f, 0.0f, 1.0f), 0.3f, 0.1f, 0xb4u),  // some not aimed at
       casterScene(r, 3, 0x3u, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.5f, 0.0f),  // no lights: refractive ones never
       casterScene(r, 5, 0x0u, glm::vec4(1.0f, 1.0f, 1.0f, 0.5f), 0.9f, 0.2f),   // mirrors only
       casterScene(r, 0, 0x0u, glm::vec4(0.0f, 2.5f, 0.0f, 0.4f), 0.3f, 0.05f),  // none: cosine sampling only
@@ -984,6 +986,7 @@ TEST_CASE("GLSL caster guiding equals its C++ twin: guideLobe; prepareCasters, d
 
   gpu::CasterParams scenes[] = {
       casterScene(r, 8, 0xa5u, glm::vec4(0.0f, 2.5f, 0.0f, 1.0f), 0.3f, 0.1f),  // every slot, some refractive
+      casterScene(r, 8, 0xa5u, glm::vec4(0.0f, 2.5f, 0.0f, 1.0f), 0.3f, 0.1f, 0x3cu),  // some cones not aimed at: lobes only
       casterScene(r, 3, 0x3u, glm::vec4(0.0f, 0.0f, 0.0f, -1.0f), 0.6f, 0.0f),  // no lights: refractive ones by lobes only
       casterScene(r, 5, 0x0u, glm::vec4(1.0f, 1.0f, 1.0f, 0.5f), 0.9f, 0.2f),   // mirrors only
   };

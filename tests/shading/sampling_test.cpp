@@ -328,6 +328,11 @@ TEST_CASE("refractive casters are aimed at only from where they overlap the ligh
   REQUIRE(v.usable == 1);
   CHECK(glm::length(v.axis[0] - glm::vec3(0, 1, 0)) < 1e-5f);
   CHECK(prepareCasters(p, n, 0.5f, spheres, 2, 2u, lights, 0.0f).usable == 1);  // `aside` glass, `above` mirror
+  // The aim mask (aimCasterMask: unguided mirrors out) removes a caster's cone whatever else holds.
+  CasterVertex only = prepareCasters(p, n, 0.5f, spheres, 2, 0u, lights, 0.0f, nullptr, 0.0f, 2u);
+  REQUIRE(only.usable == 1);
+  CHECK(glm::length(only.axis[0] - glm::normalize(glm::vec3(aside) - p)) < 1e-5f);
+  CHECK(prepareCasters(p, n, 0.5f, spheres, 2, 0u, lights, 0.0f, nullptr, 0.0f, 0u).usable == 0);
 }
 
 TEST_CASE("the caster pick is uniform over the usable casters") {
