@@ -155,7 +155,7 @@ void printFeatures(const Scene& s, const GpuScene& g) {
     std::printf("%s %s sphere at %s, radius %.3g; emitters subtend %.3g sr: %s, manifold auto %s\n",
                 i == 0 ? "casters:   " : "           ", g.casters[i].refractive ? "glass " : "mirror",
                 vec(glm::vec3(g.casters[i].sphere)).c_str(), g.casters[i].sphere.w, g.casters[i].emitterSolidAngle,
-                (aimed & (1u << i)) != 0u ? "aimed at" : "not aimed at",
+                (aimed & (1u << i)) != 0u ? "cone aimed at" : "cone not aimed at",
                 g.casters[i].manifoldAuto ? "on" : !g.casters[i].smooth ? "off (rough)" : "off");
   std::string defines;
   for (const auto& d : features.defines()) defines += " " + d;

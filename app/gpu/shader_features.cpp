@@ -96,7 +96,7 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        "--integrator mis and an emitter or an environment map", nullptr, misHasLights,
        [](const RenderSettings& s) { return s.integrator == Integrator::Mis; }, nullptr, A::Keep},
       {"casters", "CAUSTICA_CASTERS", K::Integrator, "diffuse bounces also aim at glass and mirror objects",
-       "mis, a caustic caster to aim at (aimCasterMask: glass, or a mirror the emitters look small from) and "
+       "mis, a caustic caster to aim at (aimCasterMask: glass, or a mirror no large lamp lights) and "
        "--caster-probability > 0", nullptr,
        [](const SceneView& v) { return aimCasterMask(v.gpu) != 0u; },
        [](const RenderSettings& s) { return s.casterProbability > 0.0f; }, "CAUSTICA_MIS", A::Keep},
@@ -215,9 +215,13 @@ std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g) {
 std::uint32_t guideCasterMask(const GpuScene& g) { return manifoldCasterMask(ManifoldMode::Auto, g); }
 
 std::uint32_t aimCasterMask(const GpuScene& g) {
-  std::uint32_t mask = guideCasterMask(g);
-  for (std::size_t i = 0; i < g.casters.size() && i < CAUSTICA_MAX_CASTERS; ++i)
-    if (g.casters[i].refractive) mask |= 1u << i;
+  std::uint32_t mask = 0;
+  const std::size_t n = std::min<std::size_t>(g.casters.size(), CAUSTICA_MAX_CASTERS);
+  for (std::size_t i = 0; i < n; ++i) {
+    const CausticCaster& c = g.casters[i];
+    const bool largeLamps = g.emitterCount > 0 && c.emitterSolidAngle >= kManifoldAutoSolidAngle;
+    if (c.refractive || !largeLamps) mask |= 1u << i;
+  }
   return mask;
 }
 

@@ -98,11 +98,12 @@ RenderSettings resolveManifold(RenderSettings s, const GpuScene& g);
 // subtending less than kManifoldAutoSolidAngle from them), where guiding measured a gain; under larger
 // lamps it measured a loss (docs/path-tracer.md). 0: guiding is not compiled.
 std::uint32_t guideCasterMask(const GpuScene& g);
-// The casters a diffuse bounce may aim at (caster aiming, --caster-probability): every glass caster (on
-// its shadow side, casterFacesLights), and a mirror only where caster guiding takes it (guideCasterMask:
-// the emitters look small from it). Under larger lamps a mirror's reflection of them is found by cosine
-// sampling about as often as by aiming at its whole cone, which measured a loss (docs/path-tracer.md).
-// 0: caster aiming is not compiled.
+// The casters whose cone a diffuse bounce may aim at (caster aiming, --caster-probability): every glass
+// caster (on its shadow side, casterFacesLights), and every mirror but one whose emissive triangles subtend
+// kManifoldAutoSolidAngle or more from its centre. Under such lamps a mirror's reflection of them is found
+// by cosine sampling about as often as by aiming at its whole cone, which measured a loss
+// (docs/path-tracer.md); mirrors lit by small lamps, the sun, the environment or punctual lights keep it.
+// A caster outside the mask may still get guide lobes (caster guiding). 0: caster aiming is not compiled.
 std::uint32_t aimCasterMask(const GpuScene& g);
 // Every row the mode's entry shader can read (what the shader tests compile combinations of).
 FeatureSet modeFeatureRows(RenderMode mode);

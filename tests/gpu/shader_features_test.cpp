@@ -218,10 +218,10 @@ TEST_CASE("shader features: detection from the materials some triangle uses and 
   CHECK(detect(s).describe() == "glass dispersion textures opacity environment punctual spot-emitters ggx");
 }
 
-TEST_CASE("shader features: caster aiming takes glass, and a mirror only where the emitters look small from it") {
+TEST_CASE("shader features: caster aiming takes glass, and a mirror unless a large lamp lights it") {
   // aimCasterMask: under a large lamp a mirror's reflection of it is found by cosine sampling about as often
   // as by aiming at the mirror's cone (docs/path-tracer.md), so a scene whose only caster is such a mirror
-  // does not compile caster aiming; under a small lamp the mirror is guided and aimed at.
+  // does not compile caster aiming; under a small lamp, or with no emissive triangle, the mirror is aimed at.
   Material mirror, light;
   mirror.metallic = 1.0f;
   light.emission = glm::vec3(4.0f);
@@ -241,6 +241,13 @@ TEST_CASE("shader features: caster aiming takes glass, and a mirror only where t
     CHECK(aimCasterMask(glass) == 1u);
     CHECK(detectFeatures(s, glass).has("CAUSTICA_CASTERS"));
   }
+  Scene dark;  // a mirror without emissive triangles (lit by the sun, the environment or punctual lights)
+  dark.materials = {mirror, Material{}};
+  addSquare(dark, 1.0f, 0, 0.1f);
+  addSquare(dark, 0.0f, 1);  // a floor: the mirror is a small object of the scene
+  const GpuScene g = packScene(dark, buildBvh(dark.triangles));
+  REQUIRE(g.casters.size() == 1);
+  CHECK(aimCasterMask(g) == 1u);
 }
 
 // The layers cost nothing where no triangle uses them: a coat, a sheen or a factor texture switches
