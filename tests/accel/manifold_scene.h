@@ -63,7 +63,8 @@ struct ManifoldTestScene {
 };
 
 // Builds the scene; the BVH, GpuScene and 4-wide nodes as Renderer::buildScene makes them for a flat
-// scene, and the caster UBO as Renderer::casterParams fills it. dispersiveGlass: the glass disperses
+// scene, and the caster UBO's spheres, refraction bits and parameters as Renderer::casterParams fills them
+// (not its photon-pass, guide and aim masks, which the chain code does not read). dispersiveGlass: the glass disperses
 // (Abbe number 30) and absorbs (KHR_materials_volume), which the forward tracer below does not follow.
 inline ManifoldTestScene makeManifoldTestScene(bool dispersiveGlass = false) {
   ManifoldTestScene t;
