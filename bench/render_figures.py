@@ -82,6 +82,21 @@ def render(exe, scene, args, output=None, env=None):
     return st
 
 
+def scene_regions(scene, extra=()):
+    """[(name, (x0, y0, x1, y1))] in normalized image coordinates (x right, y down): the whole image, the scene's
+    caustic region in bench/scenes.json (if it has one), then each of `extra`, a (name, box) pair or the
+    text 'NAME=x0,y0,x1,y1' (a --region option)."""
+    with open(os.path.join(BENCH, "scenes.json")) as f:
+        caustic = json.load(f)["scenes"].get(scene, {}).get("caustic")
+    regions = [("whole", (0.0, 0.0, 1.0, 1.0))] + ([("caustic", tuple(caustic))] if caustic else [])
+    for r in extra:
+        if isinstance(r, str):
+            name, box = r.split("=", 1)
+            r = (name, tuple(float(v) for v in box.split(",")))
+        regions.append((r[0], tuple(r[1])))
+    return regions
+
+
 def read_pfm(path):
     """A PFM image: (width, height, channels, float array of rows top to bottom as stored, channels interleaved)."""
     with open(path, "rb") as f:

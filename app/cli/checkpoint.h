@@ -62,9 +62,10 @@ Checkpoint readCheckpoint(const std::string& path);
 // "" when `checkpoint` belongs to this scene and this identity; otherwise what differs, e.g.
 // "seed: checkpoint 1, this render 2; scene files differ (checkpoint 0123..., this scene 4567...)".
 std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t sceneHash, const std::string& identity);
-// The same for a render of the scene packed as `gpu` (Renderer::gpuScene): the manifold lines of both
-// identities are compared as the image sees them (resolveIdentityManifold, cli/image_settings.h), so a
-// checkpoint that recorded "manifold auto" continues with --manifold off where auto finds no caster.
+// The same for a render of the scene packed as `gpu` (Renderer::gpuScene): the manifold and
+// guide-probability lines of both identities are compared as the image sees them (resolveIdentityScene,
+// cli/image_settings.h), so a checkpoint that recorded "manifold auto" continues with --manifold off where
+// auto finds no caster.
 // With gpu null (before the scene is packed) the manifold and guide-probability lines are left out of the comparison.
 std::string checkpointMismatch(const Checkpoint& checkpoint, std::uint64_t sceneHash, const std::string& identity,
                                const GpuScene* gpu);

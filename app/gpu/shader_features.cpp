@@ -217,11 +217,8 @@ std::uint32_t guideCasterMask(const GpuScene& g) { return manifoldCasterMask(Man
 std::uint32_t aimCasterMask(const GpuScene& g) {
   std::uint32_t mask = 0;
   const std::size_t n = std::min<std::size_t>(g.casters.size(), CAUSTICA_MAX_CASTERS);
-  for (std::size_t i = 0; i < n; ++i) {
-    const CausticCaster& c = g.casters[i];
-    const bool largeLamps = g.emitterCount > 0 && c.emitterSolidAngle >= kManifoldAutoSolidAngle;
-    if (c.refractive || !largeLamps) mask |= 1u << i;
-  }
+  for (std::size_t i = 0; i < n; ++i)  // emitterSolidAngle: 0 without emissive triangles
+    if (g.casters[i].refractive || g.casters[i].emitterSolidAngle < kManifoldAutoSolidAngle) mask |= 1u << i;
   return mask;
 }
 
