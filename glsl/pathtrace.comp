@@ -20,7 +20,7 @@
 #if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
 #include "lib/punctual.glsl"
 #endif
-#if defined(CAUSTICA_CASTERS) || defined(CAUSTICA_MANIFOLD)
+#if defined(CAUSTICA_CASTERS) || defined(CAUSTICA_MANIFOLD) || defined(CAUSTICA_LIGHT_TRACE)
 #include "lib/casters.glsl"
 #endif
 #if defined(CAUSTICA_MANIFOLD) || defined(CAUSTICA_GUIDING)
@@ -39,8 +39,23 @@
 
 layout(local_size_x = CAUSTICA_WORKGROUP_X, local_size_y = CAUSTICA_WORKGROUP_Y) in;
 
+#ifdef CAUSTICA_LIGHT_TRACE
+layout(binding = CAUSTICA_TEXUNIT_LIGHT_SPLATS) uniform usamplerBuffer lightSplatTexels;  // rgb32ui: low words, high words
+
+// The light tracer's estimate of pixel `pixel` for the k-th sample index of this dispatch: its
+// fixed-point sums (gpu_layout.h, kLightSplatWords) in radiance.
+vec3 lightSplat(uvec2 pixel, uint k) {
+  int t = 2 * int((k * frame.frame.y + pixel.y) * frame.frame.x + pixel.x);
+  uvec3 lo = texelFetch(lightSplatTexels, t).rgb, hi = texelFetch(lightSplatTexels, t + 1).rgb;
+  return (vec3(hi) * 4294967296.0 + vec3(lo)) * casters.params.w;
+}
+#endif
+
 #include "lib/surface.glsl"
 #include "lib/path_state.glsl"
+#ifdef CAUSTICA_LIGHT_TRACE
+#include "lib/light_trace.glsl"
+#endif
 #ifdef CAUSTICA_ENV
 #include "lib/environment_light.glsl"
 #endif
@@ -80,6 +95,10 @@ bool pathBounce(inout PathState s) {
   addEmission(s, sf);                           // path_emission.glsl: with its MIS weight
   BounceLobe lobe = chooseBounceLobe(s, sf, base.rgb);  // path_scatter.glsl
   bool nonDelta = isDiffuseLobe(lobe) || isGlossyLobe(lobe);
+#ifdef CAUSTICA_LIGHT_TRACE
+  // The light tracer's family: a Lambertian first vertex, then Lambertian or smooth ones (light_trace.glsl).
+  s.ltFamily = s.ltFamily && (s.depth == 0u ? isDiffuseLobe(lobe) : !isGlossyLobe(lobe)) && !ltLayered(sf);
+#endif
 #ifdef CAUSTICA_AOV
   // The first non-specular hit, or an emitter (albedo 1: its radiance is not divided by a colour).
   if (surfaceEmits(sf) || nonDelta)
@@ -139,6 +158,9 @@ void main() {
     while (true) {
       if (path.depth < maxDepth && pathBounce(path)) continue;
       vec3 l = path.radiance;
+#ifdef CAUSTICA_LIGHT_TRACE
+      l += lightSplat(pixel, k);  // the light tracer's paths of this sample index (light_trace.comp)
+#endif
       bool finite = !(any(isnan(l)) || any(isinf(l)));
       if (!finite) ++bad;  // counted and reported; not part of the pixel's mean (neither as black)
       addSample(sums, finite ? l : vec3(0.0), finite ? 1.0 : 0.0);

@@ -130,6 +130,10 @@ std::vector<OptionSpec> sceneOptionSpecs() {
        "mis: manifold next-event estimation, light joined to diffuse points through glass and mirror objects "
        "(caustics of small lights); auto (default) uses it through the objects the lights look small from "
        "(caustica info lists them), on through all"},
+      {"--light-tracing", "", "on|off",
+       "mis: light subpaths from the emitters through glass and mirror objects add the caustics the camera "
+       "sees on diffuse surfaces (default on; not beside --manifold on, which takes precedence)"},
+      {"--light-paths", "", "R", "light tracing: light subpaths per pixel and sample (1/64 to 64, default 0.125)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
       {"--light-radius", "", "R",
        "turn point and spot lights into emissive spheres of radius R (scene units), same power: bounces find "

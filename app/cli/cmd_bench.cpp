@@ -15,8 +15,8 @@ int cmdBench(const std::vector<std::string>& args) {
       {"--size", "", "W[xH]", "image size in pixels (default 256; H follows the camera's aspect)"},
       {"--max-seconds", "", "S", "render time per estimator run in seconds (default 20)"},
       {"--integrators", "", "LIST", "estimators to compare, comma-separated: naive, mis (manifold NEE as --manifold says, default auto), "
-       "mis-off (without manifold NEE), manifold (mis with --manifold on), mis-unguided (mis with --guide-probability 0) "
-       "(default naive,mis)"},
+       "mis-off (without manifold NEE), manifold (mis with --manifold on), mis-unguided (mis with --guide-probability 0), "
+       "mis-eye (mis with --light-tracing off) (default naive,mis)"},
       {"--adaptive", "", "LIST",
        "estimators that also get an adaptive-sampling run, comma-separated (default mis; none for none)"},
       {"--dispersion", "", "LIST", "dispersion modes for scenes with dispersive glass (default rgb,spectral)"},

@@ -41,6 +41,10 @@ RenderSettings renderSettingsFrom(const Options& opts, const Camera& camera, int
   if (!(s.guideProbability >= 0.0f && s.guideProbability <= 1.0f))
     throw Error("option --guide-probability needs a number from 0 to 1");
   s.manifold = parseManifoldMode(opts.get("--manifold", settingText(defaults.manifold)));
+  const std::string lightTracing = opts.get("--light-tracing", settingText(defaults.lightTracing));
+  if (lightTracing != "on" && lightTracing != "off") throw Error("option --light-tracing needs on or off");
+  s.lightTracing = lightTracing == "on";
+  s.lightPaths = static_cast<float>(opts.getDouble("--light-paths", defaults.lightPaths));
   s.allFeatures = opts.has("--all-features");
   s.samplesPerDispatch = opts.getInt("--samples-per-dispatch", defaults.samplesPerDispatch, 0, kMaxSamplesPerDispatch);
   s.validate();
@@ -175,14 +179,33 @@ std::string resolveIdentityManifold(const std::string& identity, const GpuScene&
 
 std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu) {
   // Guiding is not compiled without a caster it applies to: any guide probability renders as 0.
-  return editIdentityLines(resolveIdentityManifold(identity, gpu), "guide-probability", [&](const std::string& p) {
+  std::string t = editIdentityLines(resolveIdentityManifold(identity, gpu), "guide-probability", [&](const std::string& p) {
     return "guide-probability " + (guideCasterMask(gpu) == 0u ? std::string("0") : p);
+  });
+  // Light tracing as imageLightTracing decides it from the identity's own lines (a line this build cannot
+  // read leaves the text as it is: compared as it is).
+  const std::map<std::string, std::string> lines = parseLines(t);
+  if (!lines.count("light-tracing")) return t;
+  RenderSettings s;
+  try {
+    s.lightTracing = lines.at("light-tracing") == "on";
+    if (lines.count("integrator")) s.integrator = parseIntegrator(lines.at("integrator"));
+    if (lines.count("mode")) s.mode = parseRenderMode(lines.at("mode"));
+    if (lines.count("manifold")) s.manifold = parseManifoldMode(lines.at("manifold"));
+  } catch (const Error&) {
+    return t;
+  }
+  if (imageLightTracing(s, gpu)) return t;
+  t = editIdentityLines(t, "light-tracing", [](const std::string&) { return std::string("light-tracing off"); });
+  return editIdentityLines(t, "light-paths", [](const std::string&) {
+    return "light-paths " + settingText(RenderSettings{}.lightPaths);
   });
 }
 
 std::string identityWithoutSceneLines(const std::string& identity) {
   const auto drop = [](const std::string&) { return std::string(); };
-  return editIdentityLines(editIdentityLines(identity, "manifold", drop), "guide-probability", drop);
+  std::string t = editIdentityLines(editIdentityLines(identity, "manifold", drop), "guide-probability", drop);
+  return editIdentityLines(editIdentityLines(t, "light-tracing", drop), "light-paths", drop);
 }
 
 float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {
@@ -190,8 +213,19 @@ float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {
   return guides ? s.guideProbability : 0.0f;
 }
 
+bool imageLightTracing(const RenderSettings& s, const GpuScene& gpu) {
+  return s.lightTracing && s.integrator == Integrator::Mis && renderModeSpec(s.mode).pathTracer &&
+         imageManifoldMode(s.manifold, gpu) == ManifoldMode::Off && !gpu.casters.empty() && gpu.emitterCount > 0;
+}
+
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu) {
   ImageSettings s = settings;
+  // Before the manifold line is resolved (imageLightTracing resolves it itself). (Caster aiming, which
+  // light tracing turns off in some scenes, follows from the lines as they are: resolveManifold.)
+  if (!imageLightTracing(s.render, gpu)) {
+    s.render.lightTracing = false;
+    s.render.lightPaths = RenderSettings{}.lightPaths;
+  }
   s.render.manifold = imageManifoldMode(s.render.manifold, gpu);
   s.render.guideProbability = imageGuideProbability(s.render, gpu);
   return accumulationIdentity(s, camera);
@@ -203,7 +237,8 @@ std::string identityDifference(const std::string& a, const std::string& b, const
   std::map<std::string, std::string> ma = parseLines(a), mb = parseLines(b);
   // Settings added after identities were first written, with the value their absence means: an
   // identity from before caster guiding rendered without it.
-  static const std::map<std::string, std::string> kAddedLater = {{"guide-probability", "0"}};
+  static const std::map<std::string, std::string> kAddedLater = {
+      {"guide-probability", "0"}, {"light-tracing", "off"}, {"light-paths", settingText(RenderSettings{}.lightPaths)}};
   for (const auto& [key, value] : kAddedLater) {
     if (!ma.count(key) && mb.count(key)) ma[key] = value;
     if (!mb.count(key) && ma.count(key)) mb[key] = value;

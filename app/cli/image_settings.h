@@ -116,15 +116,20 @@ ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
 // aiming, no caster the emitters look small from: guideCasterMask), so that such renders continue and
 // merge whatever it says.
 float imageGuideProbability(const RenderSettings& settings, const GpuScene& gpu);
+// --light-tracing as the image sees it: on only where the light-tracing row compiles (the path tracer,
+// mis, a caster, an emissive triangle, and imageManifoldMode Off), so that renders of other scenes
+// continue and merge whatever it says (and --light-paths with it).
+bool imageLightTracing(const RenderSettings& settings, const GpuScene& gpu);
 // An identity text with its manifold line replaced by imageManifoldMode for `gpu` (a text without one
 // is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
 // "manifold auto" literally reads as what auto gives for the scene.
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
-// resolveIdentityManifold, and the guide-probability line as 0 where guiding is not compiled for the
-// scene (no caster it applies to, imageGuideProbability): what resuming compares once the scene is packed.
+// resolveIdentityManifold, the guide-probability line as 0 where guiding is not compiled for the scene
+// (no caster it applies to, imageGuideProbability), and the light-tracing line as off (light-paths as the
+// default) where light tracing is not (imageLightTracing): what resuming compares once the scene is packed.
 std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu);
-// The identity text without its manifold and guide-probability lines (what they mean depends on the
-// scene: imageManifoldMode, imageGuideProbability): what can be compared before the scene is packed.
+// The identity text without its manifold, guide-probability, light-tracing and light-paths lines (what they
+// mean depends on the scene): what can be compared before the scene is packed.
 std::string identityWithoutSceneLines(const std::string& identity);
 
 // What differs between two identity texts, "key: LABEL-A a, LABEL-B b; ..." (a key missing on one

@@ -48,6 +48,8 @@ void RenderSettings::validate() const {
     throw Error(m.str());
   }
   if (!(guideProbability >= 0.0f && guideProbability <= 1.0f)) throw Error("guide probability must be between 0 and 1");
+  if (!(lightPaths >= kMinLightPaths && lightPaths <= kMaxLightPaths))
+    throw Error("light paths per pixel must be between 1/64 and 64");
 }
 
 bool RenderSettings::operator==(const RenderSettings& o) const {
@@ -86,7 +88,7 @@ SettingsChange compareSettings(const RenderSettings& from, const RenderSettings&
   c.restart = from != to;
   c.resize = from.width != to.width || from.height != to.height;
   c.shader = from.integrator != to.integrator || from.dispersion != to.dispersion ||
-             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.manifold != to.manifold ||
+             (from.casterProbability > 0.0f) != (to.casterProbability > 0.0f) || from.manifold != to.manifold || from.lightTracing != to.lightTracing ||
              (from.guideProbability > 0.0f) != (to.guideProbability > 0.0f) ||
              from.mode != to.mode ||
              from.allFeatures != to.allFeatures;

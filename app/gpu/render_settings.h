@@ -28,6 +28,8 @@ constexpr int kMaxMaxDepth = 1024;
 constexpr float kMaxCasterProbability = 0.9f;     // every direction keeps a non-zero cosine pdf
 constexpr int kMaxImageSide = 16384;              // pixels; the GPU's texture limit may be lower
 constexpr int kMaxSamplesPerDispatch = 64;        // bound of RenderSettings::samplesPerDispatch
+constexpr float kMinLightPaths = 1.0f / 64.0f;    // bounds of RenderSettings::lightPaths
+constexpr float kMaxLightPaths = 64.0f;
 
 struct RenderSettings {
   int width = 512, height = 512;  // pixels
@@ -50,6 +52,15 @@ struct RenderSettings {
   // emitters never use it. Auto (the default) uses it only through the casters whose emitters look
   // small from them, and compiles it only where there is one (resolveManifold, shader_features.h).
   ManifoldMode manifold = ManifoldMode::Auto;
+  // mis only: light tracing of caustics: light subpaths from the emitters through glass and mirror objects
+  // splat the Lambertian points the camera sees, and take those paths over from the eye paths
+  // (docs/path-tracer.md, "Light tracing"). Compiled where the scene has a caster and an emissive
+  // triangle and manifold NEE is not on (the light-tracing row, shader_features.cpp).
+  bool lightTracing = true;
+  // Light subpaths per pixel and sample under light tracing (kMinLightPaths..kMaxLightPaths): each sample
+  // index gets width x height x lightPaths of them (at least one). More puts more of the time into the
+  // caustics the light tracer adds (docs/path-tracer.md, "Light tracing").
+  float lightPaths = 0.125f;
   RenderMode mode = RenderMode::Path;
   // Compile every material feature into the path tracer, whatever the scene uses (the shader is
   // otherwise specialised to the scene's features): measures what specialisation saves
@@ -97,6 +108,8 @@ void visitFields(Settings& s, Visit&& visit) {
   visit("caster-probability", SettingRole::Accumulation, s.casterProbability);
   visit("guide-probability", SettingRole::Accumulation, s.guideProbability);
   visit("manifold", SettingRole::Accumulation, s.manifold);
+  visit("light-tracing", SettingRole::Accumulation, s.lightTracing);
+  visit("light-paths", SettingRole::Accumulation, s.lightPaths);
   visit("mode", SettingRole::Accumulation, s.mode);
   // The same expected image; the same bits on llvmpipe (tests/gpu/error_estimate_test.cpp), to float
   // rounding elsewhere.
@@ -105,7 +118,7 @@ void visitFields(Settings& s, Visit&& visit) {
   visit("samples-per-dispatch", SettingRole::Speed, s.samplesPerDispatch);
 }
 // Added a field to RenderSettings? Add it to visitFields above (with its role), then count it here.
-static_assert(fieldCount<RenderSettings>() == 12, "RenderSettings has a field that visitFields does not list");
+static_assert(fieldCount<RenderSettings>() == 14, "RenderSettings has a field that visitFields does not list");
 
 // A setting's value as one word of text, the same in the checkpoint identity and printed settings
 // (a float as the shortest text that reads back as the same float: 0.05f is "0.05").
@@ -125,7 +138,7 @@ std::string settingText(RenderMode v);
 struct SettingsChange {
   bool restart = false;  // anything differs: the accumulated samples no longer belong to the image
   bool resize = false;   // width or height: new accumulation images
-  bool shader = false;   // integrator, dispersion mode, caster aiming or manifold NEE on/off, render mode: maybe another variant
+  bool shader = false;   // integrator, dispersion mode, caster aiming, manifold NEE or light tracing on/off, render mode: maybe another variant
   bool casters = false;  // caster probability: the caster UBO
 };
 SettingsChange compareSettings(const RenderSettings& from, const RenderSettings& to);

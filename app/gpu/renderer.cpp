@@ -104,6 +104,11 @@ Renderer::Renderer(const ShaderLibrary& library, const Scene& scene, const Camer
 void Renderer::loadScene(const Scene& scene) {
   memTrace("renderer start");
   std::vector<gpu::BvhWideNode> wideNodes = buildScene(scene);
+  // The light tracer's fixed-point step: 2^-24 of the brightest emission, so a splat as bright as an
+  // emitter has 24 bits below it and 40 above it (light_trace.comp).
+  float brightest = 0.0f;
+  for (const Material& m : scene.materials) brightest = std::max({brightest, m.emission.r, m.emission.g, m.emission.b});
+  lightSplatUnit_ = std::isfinite(brightest) && brightest > 0.0f ? brightest * 0x1p-24f : 1.0f;
   const Bounds sceneBounds = treeBounds(gpuScene_.nodes);
   planBuffers(scene);
   const auto t0 = std::chrono::steady_clock::now();
@@ -389,7 +394,7 @@ gpu::CasterParams Renderer::casterParams() const {
   cp.guide.z = aimCasterMask(gpuScene_);    // the casters a bounce aims at
   cp.count.w = manifoldCasterMask(settings_.manifold, gpuScene_);  // the photon pass's casters
   cp.count.x = static_cast<std::uint32_t>(std::min<size_t>(gpuScene_.casters.size(), CAUSTICA_MAX_CASTERS));
-  cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, settings_.guideProbability, 0.0f);
+  cp.params = glm::vec4(settings_.casterProbability, kCasterLightMargin, settings_.guideProbability, lightSplatUnit_);
   cp.lights = gpuScene_.emitterSphere;
   for (std::uint32_t i = 0; i < cp.count.x; ++i) {
     cp.sphere[i] = gpuScene_.casters[i].sphere;
@@ -428,6 +433,7 @@ void Renderer::reset() {
     normal_.clear();
   }
   useAllTiles();
+  lightCount_ = 0;
   spp_ = 0;
   sampleBase_ = 0;
   stats_ = RenderStats{};
@@ -502,14 +508,24 @@ namespace {
 constexpr int kRegenBounceBudget = 1024;
 constexpr int kDefaultSamplesPerDispatch = 4;  // docs/benchmarks.md, "Path regeneration"
 constexpr int kMaxPassThroughs = 256;          // path_state.glsl's kMaxPassThroughs
+// Bytes the light tracer's splats may take for the samples of one dispatch (24 per pixel each): 1080p
+// keeps the default 4 samples per dispatch, larger images fewer (the image does not depend on it).
+constexpr std::uint64_t kLightSplatBudget = 256ull << 20;
 }  // namespace
 
 int Renderer::samplesPerDispatch() const {
   if (renderModeSpec(settings_.mode).samples != SampleRule::Regeneration) return 1;
   const int wanted = settings_.samplesPerDispatch > 0 ? settings_.samplesPerDispatch : kDefaultSamplesPerDispatch;
   int perSample = settings_.maxDepth;
-  if (variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_)).has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
-  return std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
+  const FeatureSet variant = variantFeatures(sceneFeatures_, resolveManifold(settings_, gpuScene_));
+  if (variant.has("CAUSTICA_OPACITY")) perSample += kMaxPassThroughs;
+  int k = std::max(1, std::min(wanted, kRegenBounceBudget / perSample));
+  if (variant.has("CAUSTICA_LIGHT_TRACE")) {  // the light tracer's splats: one slot per sample of a dispatch, within a budget
+    const std::uint64_t slotBytes = static_cast<std::uint64_t>(settings_.width) * static_cast<std::uint64_t>(settings_.height) *
+                                    gpu::kLightSplatWords * 4u;
+    k = static_cast<int>(std::max<std::uint64_t>(1u, std::min<std::uint64_t>(static_cast<std::uint64_t>(k), kLightSplatBudget / slotBytes)));
+  }
+  return k;
 }
 
 // Rows [y0, y1), or with `tiles` one work group per live tile; samplesPerDispatch() samples per pixel
@@ -550,7 +566,11 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   const std::uint64_t pixelsPerDispatch =
       tiles ? std::uint64_t(liveTiles_) * std::uint64_t(liveTileSize_ * liveTileSize_)
             : static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(y1 - y0);
-  const std::uint64_t raysPerSample = pixelsPerDispatch * (2u * settings_.maxDepth + 1u + 256u);
+  const std::vector<std::string> defines = shaderDefines();
+  const bool lightTrace = std::find(defines.begin(), defines.end(), "CAUSTICA_LIGHT_TRACE") != defines.end();
+  // (each light subpath: at most maxDepth - 1 bounce rays and as many eye connections)
+  const std::uint64_t lightRays = lightTrace ? lightSubpaths() * 2u * settings_.maxDepth : 0u;
+  const std::uint64_t raysPerSample = pixelsPerDispatch * (2u * settings_.maxDepth + 1u + 256u) + lightRays;
   // Tile lists: one work group per 64 / tileSize^2 live tiles (adaptive.glsl), on a 2D grid, since one
   // dimension may hold only 65535 groups.
   const GLuint tilesPerGroup = GLuint(CAUSTICA_WORKGROUP_X * CAUSTICA_WORKGROUP_Y / (liveTileSize_ * liveTileSize_));
@@ -570,6 +590,10 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
     fp.frame = glm::uvec4(w, h, sampleBase_ + static_cast<std::uint32_t>(s), settings_.seed);
     fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), std::uint32_t(k));
     frameUbo_.update(0, sizeof fp, &fp);
+    if (lightTrace) {
+      traceLight(fp.frame.z, k);
+      prog.use();
+    }
     glDispatchCompute(groupsX, groupsY, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
     s += k;
@@ -579,6 +603,45 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
   checkGlError("path tracing dispatch");
   readCounters();  // waits for the dispatches
   if (load_.firstPass == 0.0) load_.firstPass = std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count();
+}
+
+std::uint64_t Renderer::lightSubpaths() const {
+  const double pixels = static_cast<double>(settings_.width) * static_cast<double>(settings_.height);
+  const double n = std::min(std::round(pixels * static_cast<double>(settings_.lightPaths)), 2147483648.0);  // a uint uniform
+  return std::max<std::uint64_t>(1u, static_cast<std::uint64_t>(n));
+}
+
+void Renderer::traceLight(std::uint32_t first, int k) {
+  if (lightCount_ == k && lightFirst_ == first) {  // the same sample indices (another band of rows): the same splats
+    lightSplatTexture_.bind(CAUSTICA_TEXUNIT_LIGHT_SPLATS);
+    return;
+  }
+  const std::uint64_t pixels = static_cast<std::uint64_t>(settings_.width) * static_cast<std::uint64_t>(settings_.height);
+  const std::uint64_t words = static_cast<std::uint64_t>(k) * pixels * gpu::kLightSplatWords;
+  if (lightSplats_.size() < words * 4u) {
+    checkBufferTextureTexels(words / 3u, "light tracing at this image size", "its splats need");
+    lightSplats_ = GlBuffer::create(words * 4u, nullptr, GL_DYNAMIC_COPY);
+    lightSplatTexture_ = GlBufferTexture::create(lightSplats_, GL_RGB32UI);
+  }
+  const GLuint zero = 0;
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, lightSplats_.id());
+  glClearBufferSubData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, 0, words * 4u, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+  const std::uint64_t subpaths = lightSubpaths();
+  const GlProgram& lt = compiledProgram("light_trace.comp", shaderDefines());
+  lt.use();
+  glUniform1ui(0, static_cast<GLuint>(subpaths));
+  lightSplats_.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_LIGHT_SPLATS);
+  const std::uint64_t groups = (subpaths + 63u) / 64u;
+  const GLuint groupsX = static_cast<GLuint>(std::min<std::uint64_t>(groups, 65535u));
+  const GLuint groupsY = static_cast<GLuint>((groups + groupsX - 1u) / groupsX);
+  glDispatchCompute(groupsX, groupsY, static_cast<GLuint>(k));
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  buffers_[CAUSTICA_BINDING_LIGHT_SPLATS].bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_LIGHT_SPLATS);  // the scene's again
+  lightSplatTexture_.bind(CAUSTICA_TEXUNIT_LIGHT_SPLATS);
+  lightFirst_ = first;
+  lightCount_ = k;
+  checkGlError("light tracing dispatch");
 }
 
 void Renderer::bindSceneForDispatch() {

@@ -208,6 +208,11 @@ class Renderer {
   void allocateImages();
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
+  // The light tracer's pass (light_trace.comp) for the k sample indices from frame.z of the frame UBO:
+  // their splats, read by the next path-tracing dispatch on CAUSTICA_TEXUNIT_LIGHT_SPLATS. Leaves the
+  // path tracer's program to be used again.
+  void traceLight(std::uint32_t first, int k);
+  std::uint64_t lightSubpaths() const;  // per sample index: width x height x RenderSettings::lightPaths, at least 1
   void uploadCasters();
   Image meansOf(const std::vector<float>& rgba) const;  // meanImage of sums like accum_'s, with coverage alpha
   gpu::CasterParams casterParams() const;  // the caster UBO for the current settings and cells
@@ -268,6 +273,13 @@ class Renderer {
   int liveTileSize_ = CAUSTICA_WORKGROUP_X;  // side of those tiles in pixels
   bool tileListActive_ = false;
   std::map<std::string, GlProgram> programs_;
+  // Light tracing (CAUSTICA_LIGHT_TRACE): the splats of the last light pass, for sample indices
+  // lightFirst_ .. + lightCount_ - 1 (0: none valid; reset() forgets them), as an SSBO and a buffer texture.
+  GlBuffer lightSplats_;
+  GlBufferTexture lightSplatTexture_;
+  std::uint32_t lightFirst_ = 0;
+  int lightCount_ = 0;
+  float lightSplatUnit_ = 1.0f;  // CasterParams::params.w: radiance of one fixed-point step (loadScene)
   GlProgram tonemapProgram_;
   int spp_ = 0;
   std::uint32_t sampleBase_ = 0;

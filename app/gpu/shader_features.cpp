@@ -114,6 +114,13 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        "resolveManifold) and a caster the emitters look small from (manifoldAutoEligible)", nullptr,
        [](const SceneView& v) { return !v.gpu.casters.empty() && v.gpu.emitterCount > 0; },
        [](const RenderSettings& s) { return s.manifold == ManifoldMode::On; }, "CAUSTICA_MIS", A::Keep},
+      {"light-tracing", "CAUSTICA_LIGHT_TRACE", K::Integrator,
+       "light tracing of caustics: light subpaths through glass and mirror objects splat the Lambertian points "
+       "the camera sees (glsl/light_trace.comp), and eye paths leave those paths to them",
+       "mis, a caustic caster, an emissive triangle, --light-tracing on (the default) and manifold NEE off "
+       "(--manifold off, or auto where no caster qualifies: resolveManifold)", nullptr,
+       [](const SceneView& v) { return !v.gpu.casters.empty() && v.gpu.emitterCount > 0; },
+       [](const RenderSettings& s) { return s.lightTracing && s.manifold != ManifoldMode::On; }, "CAUSTICA_MIS", A::Keep},
       {"no-emitters", "CAUSTICA_NO_EMITTERS", K::Integrator,
        "leaves the emitter estimate and the emitter-hit pdf out of mis rather than run them masked on every "
        "bounce (llvmpipe runs every branch)",
@@ -225,6 +232,12 @@ std::uint32_t aimCasterMask(const GpuScene& g) {
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g) {
   if (s.manifold == ManifoldMode::Auto)
     s.manifold = manifoldCasterMask(ManifoldMode::Auto, g) != 0 ? ManifoldMode::On : ManifoldMode::Off;
+  // Light tracing takes the caustics of the emissive triangles; an eye path aimed at a caster then mostly
+  // finds paths it leaves to the light tracer (measured: 4.7x the variance at the glass ball's focus).
+  // Only the environment's and punctual lights' caustics would still need it.
+  const bool lightTraced = s.integrator == Integrator::Mis && s.lightTracing && s.manifold != ManifoldMode::On &&
+                           !g.casters.empty() && g.emitterCount > 0;
+  if (lightTraced && g.environmentParams.size.x == 0 && g.punctual.count.x == 0) s.casterProbability = 0.0f;
   return s;
 }
 

@@ -92,7 +92,9 @@ FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settin
 std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g);
 // The settings with --manifold auto decided for the scene: On where manifoldCasterMask(Auto) holds a
 // caster, else Off (the manifold row's settings test reads On; a scene where auto finds no caster
-// compiles the same variant as off). What the Renderer asks variantFeatures with.
+// compiles the same variant as off); and caster aiming off (casterProbability 0) where light tracing is
+// compiled and the scene has no environment map or punctual light, whose caustics only aiming finds.
+// What the Renderer asks variantFeatures with.
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g);
 // The casters caster guiding sends its photons to: those --manifold auto chooses (smooth, the emitters
 // subtending less than kManifoldAutoSolidAngle from them), where guiding measured a gain; under larger

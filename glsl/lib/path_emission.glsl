@@ -32,6 +32,17 @@ void addEmission(inout PathState s, Surface sf) {
       w *= powerHeuristic(s.prevPdf, pdfLight);
     }
 #endif
+#ifdef CAUSTICA_LIGHT_TRACE
+    // A path of the light tracer's family: its light subpaths add it (light_trace.glsl), not this one.
+    if (s.ltFamily && s.prevDelta && s.depth >= 2u) {
+      bool twoSided = (sf.m.tex.z & kMatDoubleSided) != 0u;
+#ifdef CAUSTICA_INSTANCED
+      if (ltEmissionPdf(sf.g, sf.xf, sf.p, sf.ngFront, twoSided, -s.dir) > 0.0) return;
+#else
+      if (ltEmissionPdf(sf.tri, sf.p, sf.ngFront, twoSided, -s.dir) > 0.0) return;
+#endif
+    }
+#endif
     vec3 le = s.beta * s.filt * materialEmissionSeen(sf.m, sf.uv, dot(sf.ngFront, s.dir)) * w;
 #ifdef CAUSTICA_MANIFOLD
     gManifoldCheck = manifoldChainEnds(s);  // a caster chain from x ends here: weighed after the solve

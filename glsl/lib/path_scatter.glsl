@@ -18,6 +18,9 @@ bool passThrough(inout PathState s, Surface sf, float alpha) {
   if (alpha < 1.0 && rand01(s.rng) >= alpha) {
     s.org = offsetRayOrigin(sf.p, sf.pError, -sf.ng);
     s.prevDelta = true;
+#ifdef CAUSTICA_LIGHT_TRACE
+    s.ltFamily = false;  // a pass-through is never part of the light tracer's family
+#endif
     if (s.passThroughs < kMaxPassThroughs) ++s.passThroughs;  // up to that many layers of cut-outs are free
     else ++s.depth;
 #ifdef CAUSTICA_MANIFOLD

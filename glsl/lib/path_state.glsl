@@ -19,6 +19,9 @@ struct PathState {
   vec3 prevP, prevN;   // last vertex's point and shading normal (light-tree pdf for MIS)
   vec3 sigma;          // absorption coefficient of the medium the ray travels in (per scene unit)
   bool firstDiffuse;   // no diffuse vertex yet on this path
+#ifdef CAUSTICA_LIGHT_TRACE
+  bool ltFamily;       // every vertex so far may belong to the light tracer's family (light_trace.glsl)
+#endif
   uint depth;          // bounces so far (path segments traced, alpha pass-throughs not counted)
   uint passThroughs;   // alpha pass-throughs: not bounces, so they do not consume the depth cap
   uvec4 rng;
@@ -53,6 +56,9 @@ PathState startPath(uvec2 pixel, uint sampleIndex) {
   s.prevN = vec3(0.0);
   s.sigma = vec3(0.0);
   s.firstDiffuse = true;
+#ifdef CAUSTICA_LIGHT_TRACE
+  s.ltFamily = true;
+#endif
   s.depth = 0u;
   s.passThroughs = 0u;
 #ifdef CAUSTICA_MANIFOLD

@@ -54,6 +54,8 @@ using uint = std::uint32_t;
 #define CAUSTICA_BINDING_CELLS 1        // caustic_photons.comp only: SSBO of CausticCell words (atomic adds)
 #define CAUSTICA_BINDING_CELL_DROPS 2   // caustic_photons.comp only: SSBO: photons whose cell found no free slot
 #define CAUSTICA_BINDING_PHOTON_EMITTERS 3  // caustic_photons.comp only: SSBO of uvec2 per caster and emitter (photonEmitterTable)
+#define CAUSTICA_BINDING_LIGHT_SPLATS 0  // light_trace.comp only: SSBO of the light tracer's splats (kLightSplatWords, below)
+#define CAUSTICA_TEXUNIT_LIGHT_SPLATS 14 // texture unit: buffer texture (rgb32ui) over the same buffer, read by pathtrace.comp
 #define CAUSTICA_BINDING_POINT_LIGHTS 2  // UBO: PointLights (raster and Whitted modes, docs/render-modes.md)
 #define CAUSTICA_MAX_POINT_LIGHTS 8   // emitter groups the raster and Whitted modes light with
 #define CAUSTICA_BINDING_PUNCTUAL 4   // UBO: PunctualParams (KHR_lights_punctual; a UBO, not a ninth SSBO)
@@ -281,6 +283,12 @@ struct FrameParams {
   // tree: removed.)
 };
 
+// The light tracer's splats (light_trace.comp writes them, pathtrace.comp reads them): for each sample
+// index of a dispatch (slot s) and pixel (x, y), kLightSplatWords words from word kLightSplatWords *
+// ((s * height + y) * width + x): the low 32 bits of the r, g, b sums, then their high 32 bits. Each sum
+// is a 64-bit fixed-point count of steps of CasterParams.params.w (radiance).
+CAUSTICA_CONST uint kLightSplatWords = 6u;
+
 // Caustic casters: bounding spheres of the scene's specular objects (glass, mirrors), aimed at from
 // diffuse surfaces by the mis integrator so that caustic paths are found more often (std140).
 // A refractive caster is aimed at only from points that see it overlap the lights (within a margin):
@@ -295,7 +303,8 @@ struct CasterParams {
                                           // sphere i (guideCasterMask; caustic_photons.comp only); z: bit i set = a
                                           // diffuse bounce may aim at sphere i's cone (aimCasterMask); w unused
   vec4 params;                            // x: probability of aiming at a caster at a diffuse vertex; y: margin (radians);
-                                          // z: probability that an aimed bounce follows a caster's guide lobe; w unused
+                                          // z: probability that an aimed bounce follows a caster's guide lobe; w: radiance
+                                          // of one step of the light tracer's fixed-point splats (light_trace.glsl)
   vec4 lights;                            // xyz: centre, w: radius of a sphere around every emitter (world space)
   vec4 sphere[CAUSTICA_MAX_CASTERS];      // xyz: centre (world space), w: radius (scene units)
 };

@@ -71,7 +71,7 @@ endif()
 refused("half.exr.ckpt: cannot resume another render: manifold: checkpoint off, this render on"
         ${COMMON} --spp 16 --manifold on -o ${DIR}/x.exr --resume ${DIR}/half.exr.ckpt)
 run(0 lamp-caustics --size 16 --backend osmesa -q --spp 2 --manifold off -o ${DIR}/lamp-off.exr --checkpoint 1000)
-refused("lamp-off.exr.ckpt: cannot resume another render: manifold: checkpoint off, this render on"
+refused("lamp-off.exr.ckpt: cannot resume another render: light-tracing: checkpoint on, this render off; manifold: checkpoint off, this render on"
         lamp-caustics --size 16 --backend osmesa -q --spp 4 -o ${DIR}/x.exr --resume ${DIR}/lamp-off.exr.ckpt)
 if(EXISTS ${DIR}/x.exr)
   message(FATAL_ERROR "a refused resume wrote an image")

@@ -104,7 +104,7 @@ TEST_CASE("image settings: changing any field changes the identity exactly when 
     }
     if (i < fieldCount<RenderSettings>()) CHECK(changed.render != defaults.render);  // operator== sees every field
   }
-  CHECK(accumulation >= 14);  // 8 RenderSettings, 5 scene, the camera; the rest speed or output
+  CHECK(accumulation >= 16);  // 10 RenderSettings, 5 scene, the camera; the rest speed or output
   // The camera that the index picked is part of it too.
   Camera moved = camera;
   moved.yfov += 0.01f;
@@ -128,7 +128,7 @@ TEST_CASE("image settings: every field is read from its option") {
   specs.push_back({"--tonemap", "", "CURVE", ""});
   Options opts("test", "", specs);
   REQUIRE(opts.parse({"--size", "64x32", "--seed", "5", "--max-depth", "9", "--integrator", "naive", "--dispersion",
-                      "spectral", "--caster-probability", "0.25", "--guide-probability", "0.75", "--manifold", "on", "--mode", "whitted", "--all-features",
+                      "spectral", "--caster-probability", "0.25", "--guide-probability", "0.75", "--manifold", "on", "--light-tracing", "off", "--light-paths", "2", "--mode", "whitted", "--all-features",
                       "--samples-per-dispatch", "2", "--env", "0.5", "--env-strength", "2", "--env-rotation", "30",
                       "--background", "0.2,0.2,0.2", "--light-radius", "0.05", "--animation", "spin", "--anim-time", "1.5",
                       "--camera", "1", "--exposure", "1.5", "--tonemap", "clamp"}));

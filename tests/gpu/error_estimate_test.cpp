@@ -141,10 +141,14 @@ std::vector<double> averagedEstimateRatios(const std::string& name, int w, int h
 // than one in eight renders at some pixels, so the measured relMSE is mostly the 2048-spp reference's own
 // (0.068 against 0.18-0.25 at 512 spp, single runs' ratios -3.5 to 1.4): the ratio (1.08 / 1.15 / 1.42 at
 // 128 / 256 / 512 spp) measures the reference, not the estimate.
+// cornell-dispersion takes 16 seeds: with light tracing its caustic is no longer noise, and what error is
+// left comes from rarer paths (8 seeds read 0.74 at 256 spp, single runs 0.43-1.15; 16 seeds 1.11 / 0.92
+// / 0.90 at 128 / 256 / 512 spp, single runs 0.43-1.97).
 TEST_CASE("stress: error estimate on every bundled scene") {
   for (const std::string& name : assetSceneNames()) {
     if (name == "lamp-caustics") continue;
-    for (double ratio : averagedEstimateRatios(name, 32, 32, {128, 256, 512}, 2048, 8)) {
+    const int seeds = name == "cornell-dispersion" ? 16 : 8;
+    for (double ratio : averagedEstimateRatios(name, 32, 32, {128, 256, 512}, 2048, seeds)) {
       INFO(name, ": estimated / measured ", ratio);
       CHECK(ratio == Rel(1.0, 0.25));
     }
@@ -290,9 +294,10 @@ TEST_CASE("adaptive sampling: on mirror-caustic the samples go to the mirror's c
   RenderSettings rs = smallSettings(64, 64, Integrator::Mis, 7);
   // Plain mis: under the default --manifold auto, manifold NEE takes the patch's noise away (the
   // sampler meets its target at its first check, 16 spp), and there is nothing left to allocate; so
-  // does caster guiding.
+  // does caster guiding, and light tracing, which --manifold off would compile.
   rs.manifold = ManifoldMode::Off;
   rs.guideProbability = 0.0f;
+  rs.lightTracing = false;
   const PixelRect crop = cropToPixels(*info.at("mirror-caustic").caustic, rs.width, rs.height);
   Renderer r(testShaderLibrary(), scene, sceneCamera(scene), rs);
   AdaptiveSampler sampler(0.02, true);

@@ -127,9 +127,10 @@ TEST_CASE("resume from a checkpoint: the identity holds --manifold as the image 
     seed2.seed = 6;
     CHECK(cli::checkpointMismatch(*ck, hash, cli::accumulationIdentity(cli::ImageSettings{seed2}, camera), nullptr) ==
           "seed: checkpoint 5, this render 6");
-    // --manifold on is another image: refused naming both modes.
+    // --manifold on is another image: refused naming both modes (and light tracing, which only the off
+    // variant compiles: docs/path-tracer.md).
     CHECK(cli::checkpointMismatch(*ck, hash, cli::accumulationIdentity(cli::ImageSettings{onRs}, camera, gpu), &gpu) ==
-          "manifold: checkpoint off, this render on");
+          "light-tracing: checkpoint on, this render off; manifold: checkpoint off, this render on");
 
     Renderer resumed(library, scene, camera, offRs);
     resumed.restoreAccumulation(ck->state);
@@ -152,8 +153,10 @@ TEST_CASE("resume from a checkpoint: one of --manifold off does not continue aut
   {
     Renderer renderer(testShaderLibrary(), lamp, camera, rs);
     const GpuScene& gpu = renderer.gpuScene();
-    cli::Checkpoint older;  // an older build's default, --manifold off
-    older.identity = cli::accumulationIdentity(cli::ImageSettings{offRs}, camera);
+    cli::Checkpoint older;  // an older build's default, --manifold off (without light tracing, which it lacked)
+    RenderSettings olderRs = offRs;
+    olderRs.lightTracing = false;
+    older.identity = cli::accumulationIdentity(cli::ImageSettings{olderRs}, camera);
     CHECK(cli::checkpointMismatch(older, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) ==
           "manifold: checkpoint off, this render on");
     cli::Checkpoint on;

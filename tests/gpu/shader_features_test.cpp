@@ -250,6 +250,49 @@ TEST_CASE("shader features: caster aiming takes glass, and a mirror unless a lar
   CHECK(aimCasterMask(g) == 1u);
 }
 
+// Light tracing (docs/path-tracer.md): compiled where a caster and an emissive triangle meet manifold NEE
+// off (--manifold off, or auto resolved off), never beside manifold NEE or naive; where it is, eye paths
+// stop aiming at casters unless an environment map or a punctual light needs it.
+TEST_CASE("shader features: light tracing beside manifold NEE off, and caster aiming stepping aside for it") {
+  Material glass, light;
+  glass.transmission = 1.0f;
+  light.emission = glm::vec3(4.0f);
+  for (float lamp : {1.0f, 0.01f}) {  // a large lamp: auto finds no caster; a small one: auto takes the glass
+    CAPTURE(lamp);
+    Scene s;
+    s.materials = {glass, light};
+    addSquare(s, 1.0f, 0, 0.1f);
+    addSquare(s, 0.0f, 1, lamp);
+    const GpuScene g = packScene(s, buildBvh(s.triangles));
+    const FeatureSet scene = detectFeatures(s, g);
+    REQUIRE(scene.has("CAUSTICA_LIGHT_TRACE"));  // the scene's test: a caster and an emitter
+    RenderSettings rs;
+    const FeatureSet byDefault = variantFeatures(scene, resolveManifold(rs, g));
+    CHECK(byDefault.has("CAUSTICA_LIGHT_TRACE") == (lamp > 0.1f));
+    CHECK(byDefault.has("CAUSTICA_MANIFOLD") == (lamp < 0.1f));
+    CHECK(byDefault.has("CAUSTICA_CASTERS") == (lamp < 0.1f));  // aiming steps aside where light tracing runs
+    rs.manifold = ManifoldMode::Off;
+    const FeatureSet off = variantFeatures(scene, resolveManifold(rs, g));
+    CHECK(off.has("CAUSTICA_LIGHT_TRACE"));
+    CHECK_FALSE(off.has("CAUSTICA_CASTERS"));
+    rs.manifold = ManifoldMode::On;
+    CHECK_FALSE(variantFeatures(scene, resolveManifold(rs, g)).has("CAUSTICA_LIGHT_TRACE"));
+    rs.manifold = ManifoldMode::Off;
+    rs.lightTracing = false;
+    const FeatureSet eyeOnly = variantFeatures(scene, resolveManifold(rs, g));
+    CHECK_FALSE(eyeOnly.has("CAUSTICA_LIGHT_TRACE"));
+    CHECK(eyeOnly.has("CAUSTICA_CASTERS"));
+    rs.lightTracing = true;
+    rs.integrator = Integrator::Naive;
+    CHECK_FALSE(variantFeatures(scene, resolveManifold(rs, g)).has("CAUSTICA_LIGHT_TRACE"));
+  }
+  Scene dark;  // glass without an emissive triangle: nothing to trace from
+  dark.materials = {glass, Material{}};
+  addSquare(dark, 1.0f, 0, 0.1f);
+  addSquare(dark, 0.0f, 1);
+  CHECK_FALSE(detect(dark).has("CAUSTICA_LIGHT_TRACE"));
+}
+
 // The layers cost nothing where no triangle uses them: a coat, a sheen or a factor texture switches
 // its row on only through a material some triangle has (the shader reads the layer texels only then).
 TEST_CASE("shader features: clear coat, sheen and factor textures only from a material some triangle uses") {

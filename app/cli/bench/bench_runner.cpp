@@ -70,7 +70,7 @@ class BenchRunner {
     cacheDir_ = opts.get("--cache", defaultReferenceCacheDir());
     for (const auto& name : splitList(opts.get("--integrators", "naive,mis")))
       integrators_.push_back(parseEstimator(name));
-    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis, mis-off, manifold");
+    if (integrators_.empty()) throw Error("option --integrators needs at least one of naive, mis, mis-off, manifold, mis-unguided, mis-eye");
     // --adaptive: the integrators that also get an adaptive run (default mis; "none" for none).
     for (const auto& name : splitList(opts.get("--adaptive", "mis")))
       if (name != "none") adaptiveIntegrators_.push_back(parseEstimator(name));
@@ -174,6 +174,7 @@ class BenchRunner {
         run.integrator = integrator.integrator;
         run.manifold = integrator.manifold;
         if (integrator.unguided) run.guideProbability = 0.0f;
+        if (integrator.eyeOnly) run.lightTracing = false;
         renderer.apply(run);
         results.push_back(measure(renderer, name, ref, caustic, false));
         if (std::find(adaptiveIntegrators_.begin(), adaptiveIntegrators_.end(), integrator) !=
@@ -387,13 +388,15 @@ class BenchRunner {
   std::string outDir_, cacheDir_;
   // An estimator of --integrators: naive, mis (manifold NEE as --manifold says, default auto; caster
   // guiding as --guide-probability says, default on), mis-off (without manifold NEE), manifold (mis with
-  // --manifold on) or mis-unguided (mis with --guide-probability 0).
+  // --manifold on), mis-unguided (mis with --guide-probability 0) or mis-eye (mis with --light-tracing off:
+  // the eye paths alone).
   struct Estimator {
     Integrator integrator;
     ManifoldMode manifold;
     bool unguided = false;
+    bool eyeOnly = false;
     bool operator==(const Estimator& o) const {
-      return integrator == o.integrator && manifold == o.manifold && unguided == o.unguided;
+      return integrator == o.integrator && manifold == o.manifold && unguided == o.unguided && eyeOnly == o.eyeOnly;
     }
   };
   Estimator parseEstimator(const std::string& name) const {
@@ -401,6 +404,7 @@ class BenchRunner {
     if (name == "manifold") return {Integrator::Mis, ManifoldMode::On};
     if (name == "mis-off") return {Integrator::Mis, ManifoldMode::Off};
     if (name == "mis-unguided") return {Integrator::Mis, asAsked, true};
+    if (name == "mis-eye") return {Integrator::Mis, asAsked, false, true};
     return {parseIntegrator(name), asAsked};
   }
   std::vector<Estimator> integrators_, adaptiveIntegrators_;

@@ -65,6 +65,10 @@ std::string estimatorName(const RenderSettings& settings, bool sceneHasCasters) 
   if (settings.integrator == Integrator::Mis && sceneHasCasters &&
       settings.guideProbability != RenderSettings{}.guideProbability)
     name += formatDouble(" guide=%g", settings.guideProbability);
+  if (settings.integrator == Integrator::Mis && sceneHasCasters && settings.lightTracing != RenderSettings{}.lightTracing)
+    name += std::string(" light-tracing=") + (settings.lightTracing ? "on" : "off");
+  if (settings.integrator == Integrator::Mis && sceneHasCasters && settings.lightPaths != RenderSettings{}.lightPaths)
+    name += formatDouble(" light-paths=%g", settings.lightPaths);
   return name;
 }
 
