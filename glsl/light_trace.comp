@@ -66,7 +66,6 @@ void addSplat(uvec2 px, uint slot, vec3 v, inout uvec4 rng) {
 // ratio of the shading to the geometric cosine on the light's side is the adjoint BSDF's correction
 // (Veach 1997, 5.3).
 void connectEye(PathState s, Surface sf, vec3 albedo, uint slot) {
-  ++gShadowRays;
   vec3 wi = -s.dir;  // towards the light
   float cosSi = dot(wi, sf.ns), cosGi = dot(wi, sf.ng);  // sf.ng, sf.ns: on the side s arrived from
   if (!(cosSi > 0.0) || !(cosGi > 0.0)) return;
@@ -86,6 +85,7 @@ void connectEye(PathState s, Surface sf, vec3 albedo, uint slot) {
   float pixelArea = 4.0 * length(right) * length(up) / (size.x * size.y);
   float cosCam = depth / dist;
   float importance = ortho ? 1.0 / pixelArea : 1.0 / (pixelArea * cosCam * cosCam * cosCam * dist * dist);
+  ++gShadowRays;
   if (traceOccluded(offsetRayOrigin(sf.p, sf.pError, sf.ng), toEye, dist)) return;
   vec3 value = s.beta * s.filt * albedo * (INV_PI * cosSi / cosGi * cosEye * importance / float(subpaths));
   uvec4 rng = s.rng;  // the rounding's numbers: a copy, so the subpath goes on as without the splat
@@ -185,7 +185,21 @@ void main() {
       s.prevDelta = false;
     } else if (!isGlossyLobe(lobe)) {  // mirror or smooth glass: as the path tracer scatters, reversed
       vec3 wo = -s.dir;
+      float etaBefore = s.etaScale;
+      bool inAir = s.sigma == vec3(0.0);
       scatterDelta(s, sf, lobe, newDir);
+      if (gDeltaFellBack) break;  // the eye paths' fallback to the geometric normal has no reverse
+      // scatterDelta weighs a refraction by 1 / eta^2, radiance's change of scale; a light subpath carries
+      // importance, which refraction does not scale (Veach 1997, 5.2; pbrt's TransportMode::Importance):
+      // undone. (Kept, an emitter in glass lit the focus 2.25x too dark; the same factor the other way
+      // round, 2.25x too bright: "light tracing is unbiased: an emitter inside glass".)
+      float etaSq = s.etaScale / etaBefore;
+      s.beta *= etaSq;
+#ifdef CAUSTICA_VOLUME
+      // Leaving an absorbing medium it never entered: the subpath began inside it, where an eye path
+      // would have been absorbed (path_emission.glsl leaves such paths to the eye paths).
+      if (inAir && etaSq != 1.0 && !sf.front && (sf.m.tex.z & kMatHasVolume) != 0u) break;
+#endif
       float den = abs(dot(wo, sf.ng)) * abs(dot(newDir, sf.ns));
       if (!(den > 0.0)) break;
       s.beta *= abs(dot(wo, sf.ns)) * abs(dot(newDir, sf.ng)) / den;  // the adjoint correction

@@ -97,7 +97,10 @@ bool pathBounce(inout PathState s) {
   bool nonDelta = isDiffuseLobe(lobe) || isGlossyLobe(lobe);
 #ifdef CAUSTICA_LIGHT_TRACE
   // The light tracer's family: a Lambertian first vertex, then Lambertian or smooth ones (light_trace.glsl).
-  s.ltFamily = s.ltFamily && (s.depth == 0u ? isDiffuseLobe(lobe) : !isGlossyLobe(lobe)) && !ltLayered(sf);
+  // A later Lambertian vertex needs the direction back along the path above its shading normal: the light
+  // subpath samples that direction about it.
+  s.ltFamily = s.ltFamily && (s.depth == 0u ? isDiffuseLobe(lobe) : !isGlossyLobe(lobe)) && !ltLayered(sf) &&
+               (s.depth == 0u || !isDiffuseLobe(lobe) || dot(-s.dir, sf.ns) > 0.0);
 #endif
 #ifdef CAUSTICA_AOV
   // The first non-specular hit, or an emitter (albedo 1: its radiance is not divided by a colour).
@@ -123,6 +126,9 @@ bool pathBounce(inout PathState s) {
     if (!scatterNonDelta(s, sf, v, lobe, newDir)) return false;
   } else {
     scatterDelta(s, sf, lobe, newDir);  // mirror, smooth glass
+#ifdef CAUSTICA_LIGHT_TRACE
+    if (gDeltaFellBack) s.ltFamily = false;  // not the reverse of a light subpath's event
+#endif
   }
 #ifdef CAUSTICA_MANIFOLD
   trackCasterChain(s, sf, lobe.lobe, newDir, atX);

@@ -132,7 +132,8 @@ std::vector<OptionSpec> sceneOptionSpecs() {
        "(caustica info lists them), on through all"},
       {"--light-tracing", "", "on|off",
        "mis: light subpaths from the emitters through glass and mirror objects add the caustics the camera "
-       "sees on diffuse surfaces (default on; not beside --manifold on, which takes precedence)"},
+       "sees on diffuse surfaces (default on; not beside manifold NEE: --manifold on, or auto where it takes a "
+       "caster, takes precedence)"},
       {"--light-paths", "", "R", "light tracing: light subpaths per pixel and sample (1/64 to 64, default 0.125)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
       {"--light-radius", "", "R",

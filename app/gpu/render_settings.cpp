@@ -49,7 +49,7 @@ void RenderSettings::validate() const {
   }
   if (!(guideProbability >= 0.0f && guideProbability <= 1.0f)) throw Error("guide probability must be between 0 and 1");
   if (!(lightPaths >= kMinLightPaths && lightPaths <= kMaxLightPaths))
-    throw Error("light paths per pixel must be between 1/64 and 64");
+    throw Error("option --light-paths needs a number from 1/64 to 64 (light subpaths per pixel and sample)");
 }
 
 bool RenderSettings::operator==(const RenderSettings& o) const {

@@ -127,6 +127,8 @@ void Renderer::setScene(const Scene& scene, const Camera& camera) {
   raster_.reset();  // the raster pipeline holds the previous scene's mesh
   causticCells_ = CausticCells();  // the photon cells are the previous scene's: program() builds the new ones
   causticGuides_ = CausticCells(CellTable::Guide);
+  lightSplatTexture_ = GlBufferTexture();  // the light tracer's splats: sized for the next scene when it first runs
+  lightSplats_ = GlBuffer();
   guideTableMask_ = 0;
   cellTableMask_ = 0;
   cellCasters_ = 0;
@@ -289,6 +291,7 @@ const GlProgram& Renderer::program() {
     buildCausticCells(CellTable::Manifold);
   // The guide photon pass, once per scene, before the first variant with caster guiding runs.
   if (!causticGuides_.built() && has("CAUSTICA_GUIDING")) buildCausticCells(CellTable::Guide);
+  if (has("CAUSTICA_LIGHT_TRACE")) compiledProgram("light_trace.comp", defines);  // compiled with the variant: its errors surface here
   const char* entry = renderModeSpec(settings_.mode).entryShader;
   if (!entry) throw Error(std::string("internal: the ") + renderModeName(settings_.mode) + " mode has no compute shader");
   return compiledProgram(entry, defines);
@@ -523,7 +526,8 @@ int Renderer::samplesPerDispatch() const {
   if (variant.has("CAUSTICA_LIGHT_TRACE")) {  // the light tracer's splats: one slot per sample of a dispatch, within a budget
     const std::uint64_t slotBytes = static_cast<std::uint64_t>(settings_.width) * static_cast<std::uint64_t>(settings_.height) *
                                     gpu::kLightSplatWords * 4u;
-    k = static_cast<int>(std::max<std::uint64_t>(1u, std::min<std::uint64_t>(static_cast<std::uint64_t>(k), kLightSplatBudget / slotBytes)));
+    const std::uint64_t budget = std::min<std::uint64_t>(kLightSplatBudget, static_cast<std::uint64_t>(limits_.maxStorageBlockSize));
+    k = static_cast<int>(std::max<std::uint64_t>(1u, std::min<std::uint64_t>(static_cast<std::uint64_t>(k), budget / slotBytes)));
   }
   return k;
 }
@@ -619,6 +623,10 @@ void Renderer::traceLight(std::uint32_t first, int k) {
   const std::uint64_t pixels = static_cast<std::uint64_t>(settings_.width) * static_cast<std::uint64_t>(settings_.height);
   const std::uint64_t words = static_cast<std::uint64_t>(k) * pixels * gpu::kLightSplatWords;
   if (lightSplats_.size() < words * 4u) {
+    if (words * 4u > static_cast<std::uint64_t>(limits_.maxStorageBlockSize))
+      throw Error("light tracing at " + std::to_string(settings_.width) + "x" + std::to_string(settings_.height) + " needs " +
+                  std::to_string(words * 4u >> 20) + " MiB of splats per sample, over this GPU's storage-block limit of " +
+                  std::to_string(limits_.maxStorageBlockSize >> 20) + " MiB: render with --light-tracing off or a smaller image");
     checkBufferTextureTexels(words / 3u, "light tracing at this image size", "its splats need");
     lightSplats_ = GlBuffer::create(words * 4u, nullptr, GL_DYNAMIC_COPY);
     lightSplatTexture_ = GlBufferTexture::create(lightSplats_, GL_RGB32UI);
@@ -636,8 +644,10 @@ void Renderer::traceLight(std::uint32_t first, int k) {
   const GLuint groupsX = static_cast<GLuint>(std::min<std::uint64_t>(groups, 65535u));
   const GLuint groupsY = static_cast<GLuint>((groups + groupsX - 1u) / groupsX);
   glDispatchCompute(groupsX, groupsY, static_cast<GLuint>(k));
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-  buffers_[CAUSTICA_BINDING_LIGHT_SPLATS].bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_LIGHT_SPLATS);  // the scene's again
+  // The path tracer fetches the splats; the next light pass clears them (a buffer update after shader writes).
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  static_assert(CAUSTICA_BINDING_LIGHT_SPLATS == CAUSTICA_BINDING_NODES, "the light pass borrows the nodes' binding");
+  buffers_[CAUSTICA_BINDING_NODES].bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_NODES);  // the scene's again
   lightSplatTexture_.bind(CAUSTICA_TEXUNIT_LIGHT_SPLATS);
   lightFirst_ = first;
   lightCount_ = k;

@@ -34,7 +34,8 @@ void addEmission(inout PathState s, Surface sf) {
 #endif
 #ifdef CAUSTICA_LIGHT_TRACE
     // A path of the light tracer's family: its light subpaths add it (light_trace.glsl), not this one.
-    if (s.ltFamily && s.prevDelta && s.depth >= 2u) {
+    // (An emitter reached inside an absorbing medium is not: light subpaths start with none.)
+    if (s.ltFamily && s.prevDelta && s.depth >= 2u && s.sigma == vec3(0.0)) {
       bool twoSided = (sf.m.tex.z & kMatDoubleSided) != 0u;
 #ifdef CAUSTICA_INSTANCED
       if (ltEmissionPdf(sf.g, sf.xf, sf.p, sf.ngFront, twoSided, -s.dir) > 0.0) return;

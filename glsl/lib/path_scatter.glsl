@@ -197,12 +197,18 @@ bool scatterNonDelta(inout PathState s, Surface sf, Vertex v, BounceLobe l, inou
   return true;
 }
 
+bool gDeltaFellBack = false;  // the last scatterDelta used the geometric normal (its shading normal misled it)
+
 // A delta lobe's direction (mirror, smooth clear coat, smooth glass) and throughput.
 void scatterDelta(inout PathState s, Surface sf, BounceLobe l, out vec3 newDir) {
+  gDeltaFellBack = false;
 #ifdef CAUSTICA_MIRROR_LOBE
   if (l.lobe == kLobeMirror) {
     newDir = reflect(s.dir, sf.ns);
-    if (dot(newDir, sf.ng) <= 0.0) newDir = reflect(s.dir, sf.ng);
+    if (dot(newDir, sf.ng) <= 0.0) {
+      newDir = reflect(s.dir, sf.ng);
+      gDeltaFellBack = true;
+    }
     s.beta *= l.color;
     s.prevDelta = true;
   }
@@ -215,8 +221,10 @@ void scatterDelta(inout PathState s, Surface sf, BounceLobe l, out vec3 newDir) 
     bool transmitted;
     float u = rand01(s.rng);
     float weight = sampleDielectric(s.dir, sf.ns, l.eta, u, newDir, transmitted);
-    if (transmitted ? dot(newDir, sf.ng) >= 0.0 : dot(newDir, sf.ng) <= 0.0)  // shading normal misled: use ng
+    if (transmitted ? dot(newDir, sf.ng) >= 0.0 : dot(newDir, sf.ng) <= 0.0) {  // shading normal misled: use ng
       weight = sampleDielectric(s.dir, sf.ng, l.eta, u, newDir, transmitted);
+      gDeltaFellBack = true;
+    }
     s.beta *= weight;
     if (transmitted) {
       s.beta *= l.color;  // KHR_materials_transmission: transmitted light is tinted by the base colour
