@@ -89,7 +89,7 @@ TEST_CASE("include cycles expand each file once; missing files and #version line
   fs::remove_all(dir);
 }
 
-TEST_CASE("every render mode's entry shader compiles with every combination of up to 3 of its feature rows, and all but up to 2 (glslang, GLSL 4.30 core)") {
+TEST_CASE("every render mode's entry shader compiles with every combination of up to 3 of its feature rows, and all but up to 2 (glslang, GLSL 4.30 core); light_trace.comp with each that has light tracing") {
   // The rows are the shader-feature table's (app/gpu/shader_features.cpp) that the mode compiles. The
   // full cross product (2^15 variants of pathtrace.comp) takes hours; every feature is an #ifdef block,
   // so what can break is how up to a few of them meet: every triple, and every set missing at most
@@ -126,6 +126,13 @@ TEST_CASE("every render mode's entry shader compiles with every combination of u
       const std::string log = validate(lib.expand(mode.entryShader, defines));
       REQUIRE_MESSAGE(log.empty(), log);
       ++variants;
+      // The light tracer's pass is compiled with its path tracer's defines (Renderer::traceLight).
+      if (std::find(defines.begin(), defines.end(), "CAUSTICA_LIGHT_TRACE") != defines.end()) {
+        const std::string lightLog = validate(lib.expand("light_trace.comp", defines));
+        INFO("light_trace.comp");
+        REQUIRE_MESSAGE(lightLog.empty(), lightLog);
+        ++variants;
+      }
     }
     MESSAGE(std::string(mode.entryShader), ": ", variants, " variants compiled");
   }
