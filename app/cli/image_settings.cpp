@@ -213,10 +213,7 @@ float imageGuideProbability(const RenderSettings& s, const GpuScene& gpu) {
   return guides ? s.guideProbability : 0.0f;
 }
 
-bool imageLightTracing(const RenderSettings& s, const GpuScene& gpu) {
-  return s.lightTracing && s.integrator == Integrator::Mis && renderModeSpec(s.mode).pathTracer &&
-         imageManifoldMode(s.manifold, gpu) == ManifoldMode::Off && !gpu.casters.empty() && gpu.emitterCount > 0;
-}
+bool imageLightTracing(const RenderSettings& s, const GpuScene& gpu) { return lightTracingCompiled(s, gpu); }
 
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu) {
   ImageSettings s = settings;

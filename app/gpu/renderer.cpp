@@ -595,7 +595,7 @@ void Renderer::dispatchSamples(int spp, int y0, int y1, bool tiles) {
     fp.options = glm::uvec4(settings_.maxDepth, tiles ? liveTiles_ : 0u, static_cast<std::uint32_t>(gpuScene_.emitterCount), std::uint32_t(k));
     frameUbo_.update(0, sizeof fp, &fp);
     if (lightTrace) {
-      traceLight(fp.frame.z, k);
+      traceLight(fp.frame.z, k, defines);
       prog.use();
     }
     glDispatchCompute(groupsX, groupsY, 1);
@@ -615,7 +615,7 @@ std::uint64_t Renderer::lightSubpaths() const {
   return std::max<std::uint64_t>(1u, static_cast<std::uint64_t>(n));
 }
 
-void Renderer::traceLight(std::uint32_t first, int k) {
+void Renderer::traceLight(std::uint32_t first, int k, const std::vector<std::string>& defines) {
   if (lightCount_ == k && lightFirst_ == first) {  // the same sample indices (another band of rows): the same splats
     lightSplatTexture_.bind(CAUSTICA_TEXUNIT_LIGHT_SPLATS);
     return;
@@ -636,7 +636,7 @@ void Renderer::traceLight(std::uint32_t first, int k) {
   glClearBufferSubData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, 0, words * 4u, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
   const std::uint64_t subpaths = lightSubpaths();
-  const GlProgram& lt = compiledProgram("light_trace.comp", shaderDefines());
+  const GlProgram& lt = compiledProgram("light_trace.comp", defines);
   lt.use();
   glUniform1ui(0, static_cast<GLuint>(subpaths));
   lightSplats_.bindBase(GL_SHADER_STORAGE_BUFFER, CAUSTICA_BINDING_LIGHT_SPLATS);

@@ -208,10 +208,11 @@ class Renderer {
   void allocateImages();
   void readCounters();
   void dispatchSamples(int spp, int y0, int y1, bool tiles);
-  // The light tracer's pass (light_trace.comp) for the k sample indices from frame.z of the frame UBO:
+  // The light tracer's pass (light_trace.comp, compiled with the path tracer's `defines`) for the k sample
+  // indices from frame.z of the frame UBO:
   // their splats, read by the next path-tracing dispatch on CAUSTICA_TEXUNIT_LIGHT_SPLATS. Leaves the
   // path tracer's program to be used again.
-  void traceLight(std::uint32_t first, int k);
+  void traceLight(std::uint32_t first, int k, const std::vector<std::string>& defines);
   std::uint64_t lightSubpaths() const;  // per sample index: width x height x RenderSettings::lightPaths, at least 1
   void uploadCasters();
   Image meansOf(const std::vector<float>& rgba) const;  // meanImage of sums like accum_'s, with coverage alpha

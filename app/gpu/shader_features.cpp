@@ -229,15 +229,20 @@ std::uint32_t aimCasterMask(const GpuScene& g) {
   return mask;
 }
 
-RenderSettings resolveManifold(RenderSettings s, const GpuScene& g) {
+bool lightTracingCompiled(RenderSettings s, const GpuScene& g) {
   if (s.manifold == ManifoldMode::Auto)
     s.manifold = manifoldCasterMask(ManifoldMode::Auto, g) != 0 ? ManifoldMode::On : ManifoldMode::Off;
+  return s.lightTracing && s.integrator == Integrator::Mis && renderModeSpec(s.mode).pathTracer &&
+         s.manifold != ManifoldMode::On && !g.casters.empty() && g.emitterCount > 0;
+}
+
+RenderSettings resolveManifold(RenderSettings s, const GpuScene& g) {
   // Light tracing takes the caustics of the emissive triangles; an eye path aimed at a caster then mostly
   // finds paths it leaves to the light tracer (measured: 4.7x the variance at the glass ball's focus).
   // Only the environment's and punctual lights' caustics would still need it.
-  const bool lightTraced = s.integrator == Integrator::Mis && s.lightTracing && s.manifold != ManifoldMode::On &&
-                           !g.casters.empty() && g.emitterCount > 0;
-  if (lightTraced && g.environmentParams.size.x == 0 && g.punctual.count.x == 0) s.casterProbability = 0.0f;
+  if (lightTracingCompiled(s, g) && g.environmentParams.size.x == 0 && g.punctual.count.x == 0) s.casterProbability = 0.0f;
+  if (s.manifold == ManifoldMode::Auto)
+    s.manifold = manifoldCasterMask(ManifoldMode::Auto, g) != 0 ? ManifoldMode::On : ManifoldMode::Off;
   return s;
 }
 

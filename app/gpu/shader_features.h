@@ -96,6 +96,10 @@ std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g);
 // compiled and the scene has no environment map or punctual light, whose caustics only aiming finds.
 // What the Renderer asks variantFeatures with.
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g);
+// Whether the light-tracing row compiles for settings `s` (--manifold auto resolved or not) on `g`: the
+// path tracer, mis, --light-tracing on, manifold NEE off, a caster and an emissive triangle. The one test
+// resolveManifold and the accumulation identity (imageLightTracing) share.
+bool lightTracingCompiled(RenderSettings s, const GpuScene& g);
 // The casters caster guiding sends its photons to: those --manifold auto chooses (smooth, the emitters
 // subtending less than kManifoldAutoSolidAngle from them), where guiding measured a gain; under larger
 // lamps it measured a loss (docs/path-tracer.md). 0: guiding is not compiled.
