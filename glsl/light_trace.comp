@@ -92,40 +92,24 @@ void connectEye(PathState s, Surface sf, vec3 albedo, uint slot) {
   addSplat(px, slot, value, rng);
 }
 
-// Where subpath s leaves: a caster picked uniformly, a point on an emitter by the light tree from its
-// centre, a uniform direction in its cone from there (ltEmissionPdf: the mixture's density), and the
-// throughput Le cos / pdf. False when nothing leaves.
+// Where subpath s leaves (sampleLtEmission, lib/light_trace.glsl): its origin, direction and throughput
+// Le cos / pdf. False when nothing leaves.
 bool startSubpath(inout PathState s) {
-  uint count = min(casters.count.x, uint(CAUSTICA_MAX_CASTERS));
-  if (count == 0u || frame.options.z == 0u) return false;
-  uint c = min(uint(rand01(s.rng) * float(count)), count - 1u);
-  vec4 sphere = casters.sphere[c];
-  uint tri;
-  float pmf;
+  if (frame.options.z == 0u) return false;
+  float uCaster = rand01(s.rng);
   float uSelect = rand01(s.rng);
   vec2 uTri = rand2(s.rng);
   vec2 uDir = rand2(s.rng);
-  if (!sampleLightTree(sphere.xyz, vec3(0.0), uSelect, tri, pmf)) return false;
   LightSample ls;
-  if (!sampleLightTriangle(sphere.xyz, tri, pmf, uTri, ls)) return false;
-  vec3 axis;
-  float omc;
-  if (!casterCone(ls.p, ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n, sphere, axis, omc)) return false;
-  vec3 w = sampleUniformCone(axis, omc, uDir);
-  float side = dot(w, ls.n);
-  if (!(side > 0.0 || ls.twoSided)) return false;
-  if (!sampleLightTriangle(ls.p + w, tri, pmf, uTri, ls)) return false;  // the same point; its radiance along w
-#ifdef CAUSTICA_INSTANCED
-  float pdf = ltEmissionPdf(instanceTriangle(tri, instanceXform(gLightInstance)), instanceXform(gLightInstance), ls.p,
-                            ls.n, ls.twoSided, w);
-#else
-  float pdf = ltEmissionPdf(tri, ls.p, ls.n, ls.twoSided, w);
-#endif
-  if (!(pdf > 0.0)) return false;
+  uint tri;
+  vec3 w;
+  float pdf;
+  if (!sampleLtEmission(uCaster, uSelect, uTri, uDir, ls, tri, w, pdf)) return false;
   vec3 le = ls.le;
 #ifdef CAUSTICA_SPOT_EMITTERS
   le *= spotEmitterFactor(materialAt(ls.material), w);
 #endif
+  float side = dot(w, ls.n);
   s.beta = le * (abs(side) / pdf);
   s.org = offsetRayOrigin(ls.p, ls.pError, side > 0.0 ? ls.n : -ls.n);
   s.dir = w;

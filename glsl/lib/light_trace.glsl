@@ -1,6 +1,6 @@
 // light_trace.glsl — what the light tracer (light_trace.comp) and the path tracer agree on: the family
 // of paths the light tracer takes over and the density it leaves emitters with (docs/path-tracer.md,
-// "Light tracing"). Needs casters.glsl, lights.glsl, surface.glsl, materials.glsl.
+// "Light tracing"). Needs sampling.glsl, casters.glsl, lights.glsl, surface.glsl, materials.glsl.
 //
 // The family: a Lambertian vertex seen directly by the camera (x1), then any number of Lambertian or
 // smooth (mirror, smooth glass) vertices, the last event before an emissive triangle smooth, and the
@@ -49,4 +49,36 @@ float ltEmissionPdf(LtEmitter, vec3 y, vec3 n, bool twoSided, vec3 w) {
     sum += ltEmitterPdfArea(s.xyz) / (2.0 * PI * omc);
   }
   return count > 0u ? sum / float(count) : 0.0;
+}
+
+// Where a light subpath leaves (light_trace.comp's start), with ltEmissionPdf its density: caster
+// floor(uCaster x casters.count.x), a point on an emissive triangle by the light tree from its centre
+// (uSelect, uTri), a uniform direction w in the caster's cone from there (uDir). ls: the point, with its
+// radiance along w; tri: its triangle (instanced: within the light tree leaf's instance, gLightInstance);
+// pdf: ltEmissionPdf(ls.p, w), per unit area and steradian. False when nothing leaves (w behind a one-sided
+// emitter, or pdf 0). tests/gpu/light_trace_gpu_test.cpp holds its histogram against pdf (chi-square).
+bool sampleLtEmission(float uCaster, float uSelect, vec2 uTri, vec2 uDir, out LightSample ls, out uint tri,
+                      out vec3 w, out float pdf) {
+  pdf = 0.0;
+  w = vec3(0.0);
+  tri = 0u;
+  uint count = min(casters.count.x, uint(CAUSTICA_MAX_CASTERS));
+  if (count == 0u) return false;
+  vec4 sphere = casters.sphere[min(uint(uCaster * float(count)), count - 1u)];
+  float pmf;
+  if (!sampleLightTree(sphere.xyz, vec3(0.0), uSelect, tri, pmf)) return false;
+  if (!sampleLightTriangle(sphere.xyz, tri, pmf, uTri, ls)) return false;
+  vec3 axis;
+  float omc;
+  if (!casterCone(ls.p, ls.twoSided ? normalize(sphere.xyz - ls.p) : ls.n, sphere, axis, omc)) return false;
+  w = sampleUniformCone(axis, omc, uDir);
+  if (!(dot(w, ls.n) > 0.0 || ls.twoSided)) return false;
+  if (!sampleLightTriangle(ls.p + w, tri, pmf, uTri, ls)) return false;  // the same point; its radiance along w
+#ifdef CAUSTICA_INSTANCED
+  pdf = ltEmissionPdf(instanceTriangle(tri, instanceXform(gLightInstance)), instanceXform(gLightInstance), ls.p,
+                      ls.n, ls.twoSided, w);
+#else
+  pdf = ltEmissionPdf(tri, ls.p, ls.n, ls.twoSided, w);
+#endif
+  return pdf > 0.0;
 }
