@@ -150,13 +150,17 @@ void printFeatures(const Scene& s, const GpuScene& g) {
   const FeatureSet features = detectFeatures(s, g).only(FeatureKind::Scene);  // shader_features.cpp
   std::printf("features:   %s\n", features.describe().c_str());
   if (g.casters.empty()) std::printf("casters:    none (no glass or mirror object)\n");
-  const std::uint32_t aimed = aimCasterMask(g);
+  // Under the default settings (resolveManifold: beside light tracing, only where small lamps light a caster).
+  const std::uint32_t aimed = resolveManifold(RenderSettings{}, g).casterProbability > 0.0f ? aimCasterMask(g) : 0u;
   for (size_t i = 0; i < g.casters.size(); ++i)
     std::printf("%s %s sphere at %s, radius %.3g; emitters subtend %.3g sr: %s, manifold auto %s\n",
                 i == 0 ? "casters:   " : "           ", g.casters[i].refractive ? "glass " : "mirror",
                 vec(glm::vec3(g.casters[i].sphere)).c_str(), g.casters[i].sphere.w, g.casters[i].emitterSolidAngle,
                 (aimed & (1u << i)) != 0u ? "cone aimed at" : "cone not aimed at",
-                g.casters[i].manifoldAuto ? "on" : !g.casters[i].smooth ? "off (rough)" : "off");
+                g.casters[i].manifoldAuto ? "on (under --light-tracing off)" : !g.casters[i].smooth ? "off (rough)" : "off");
+  if (!g.casters.empty() && g.emitterCount > 0)  // lightTracingCompiled under the default settings
+    std::printf("caustics:   light tracing from the emissive triangles (the default; --manifold auto takes manifold NEE "
+                "only under --light-tracing off)\n");
   std::string defines;
   for (const auto& d : features.defines()) defines += " " + d;
   for (const auto& d : g.instanceDefines()) defines += " " + d;  // the two-level traversal, as the renderer adds it

@@ -137,8 +137,9 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& c)
   return t + '\n';
 }
 
-ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu) {
-  if (mode != ManifoldMode::Auto) return mode;
+ManifoldMode imageManifoldMode(const RenderSettings& settings, const GpuScene& gpu) {
+  if (settings.manifold != ManifoldMode::Auto) return settings.manifold;
+  if (lightTracingCompiled(settings, gpu)) return ManifoldMode::Off;  // resolveManifold: light tracing first
   const std::uint32_t casters = manifoldCasterMask(ManifoldMode::Auto, gpu);
   if (casters == 0) return ManifoldMode::Off;
   return casters == manifoldCasterMask(ManifoldMode::On, gpu) ? ManifoldMode::On : ManifoldMode::Auto;
@@ -165,37 +166,43 @@ std::string editIdentityLines(const std::string& identity, const std::string& ke
 
 }  // namespace
 
-std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu) {
-  return editIdentityLines(identity, "manifold", [&](const std::string& mode) {
-    ManifoldMode m;
-    try {
-      m = parseManifoldMode(mode);
-    } catch (const Error&) {
-      return "manifold " + mode;  // not a mode this build knows: compared as it is (and differs)
-    }
-    return std::string("manifold ") + manifoldModeName(imageManifoldMode(m, gpu));
-  });
-}
+namespace {
 
-std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu) {
-  // Guiding is not compiled without a caster it applies to: any guide probability renders as 0.
-  std::string t = editIdentityLines(resolveIdentityManifold(identity, gpu), "guide-probability", [&](const std::string& p) {
-    return "guide-probability " + (guideCasterMask(gpu) == 0u ? std::string("0") : p);
-  });
-  // Light tracing as imageLightTracing decides it from the identity's own lines (a line this build cannot
-  // read leaves the text as it is: compared as it is).
-  const std::map<std::string, std::string> lines = parseLines(t);
-  if (!lines.count("light-tracing")) return t;
-  RenderSettings s;
+// The settings an identity's light-tracing, integrator, mode and manifold lines give (a missing light-tracing
+// line: off, kAddedLater's meaning); false where a line is not one this build can read.
+bool identityLightSettings(const std::string& identity, RenderSettings& s) {
+  const std::map<std::string, std::string> lines = parseLines(identity);
+  s.lightTracing = lines.count("light-tracing") && lines.at("light-tracing") == "on";
   try {
-    s.lightTracing = lines.at("light-tracing") == "on";
     if (lines.count("integrator")) s.integrator = parseIntegrator(lines.at("integrator"));
     if (lines.count("mode")) s.mode = parseRenderMode(lines.at("mode"));
     if (lines.count("manifold")) s.manifold = parseManifoldMode(lines.at("manifold"));
   } catch (const Error&) {
-    return t;
+    return false;
   }
-  if (imageLightTracing(s, gpu)) return t;
+  return true;
+}
+
+}  // namespace
+
+std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu) {
+  RenderSettings s;
+  if (!identityLightSettings(identity, s)) return identity;  // compared as it is (and differs)
+  return editIdentityLines(identity, "manifold", [&](const std::string&) {
+    return std::string("manifold ") + manifoldModeName(imageManifoldMode(s, gpu));
+  });
+}
+
+std::string resolveIdentityScene(const std::string& identity, const GpuScene& gpu) {
+  // Light tracing as imageLightTracing decides it from the identity's own lines, before the manifold line
+  // is resolved (a line this build cannot read leaves the text as it is: compared as it is).
+  RenderSettings s;
+  const bool readable = identityLightSettings(identity, s);
+  // Guiding is not compiled without a caster it applies to: any guide probability renders as 0.
+  std::string t = editIdentityLines(resolveIdentityManifold(identity, gpu), "guide-probability", [&](const std::string& p) {
+    return "guide-probability " + (guideCasterMask(gpu) == 0u ? std::string("0") : p);
+  });
+  if (!readable || !parseLines(t).count("light-tracing") || imageLightTracing(s, gpu)) return t;
   t = editIdentityLines(t, "light-tracing", [](const std::string&) { return std::string("light-tracing off"); });
   return editIdentityLines(t, "light-paths", [](const std::string&) {
     return "light-paths " + settingText(RenderSettings{}.lightPaths);
@@ -217,13 +224,11 @@ bool imageLightTracing(const RenderSettings& s, const GpuScene& gpu) { return li
 
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu) {
   ImageSettings s = settings;
-  // Before the manifold line is resolved (imageLightTracing resolves it itself). (Caster aiming, which
-  // light tracing turns off in some scenes, follows from the lines as they are: resolveManifold.)
-  if (!imageLightTracing(s.render, gpu)) {
+  s.render.manifold = imageManifoldMode(settings.render, gpu);
+  if (!imageLightTracing(settings.render, gpu)) {  // as the settings were given (auto unresolved)
     s.render.lightTracing = false;
     s.render.lightPaths = RenderSettings{}.lightPaths;
   }
-  s.render.manifold = imageManifoldMode(s.render.manifold, gpu);
   s.render.guideProbability = imageGuideProbability(s.render, gpu);
   return accumulationIdentity(s, camera);
 }

@@ -107,21 +107,21 @@ std::string accumulationIdentity(const ImageSettings& settings, const Camera& ca
 // record and resuming compares, so that `--manifold auto` on a scene where auto finds no caster
 // continues a `--manifold off` render and the other way round.
 std::string accumulationIdentity(const ImageSettings& settings, const Camera& camera, const GpuScene& gpu);
-// The manifold mode that decides the image of the scene packed as `gpu`: Auto becomes Off where it
-// sends photons to no caster (resolveManifold: the off variant), On where it takes every caster On
-// takes (the same variant and photon cells), and stays Auto where it takes some casters only (an image
-// neither On nor Off renders). On and Off stay as given.
-ManifoldMode imageManifoldMode(ManifoldMode mode, const GpuScene& gpu);
+// The manifold mode that decides the image of the scene packed as `gpu` under `settings`: Auto becomes
+// Off where light tracing compiles or where it sends photons to no caster (resolveManifold: the off
+// variant), On where it takes every caster On takes (the same variant and photon cells), and stays Auto
+// where it takes some casters only (an image neither On nor Off renders). On and Off stay as given.
+ManifoldMode imageManifoldMode(const RenderSettings& settings, const GpuScene& gpu);
 // --guide-probability as the image sees it: 0 where caster guiding is not compiled (naive, no caster
 // aiming, no caster the emitters look small from: guideCasterMask), so that such renders continue and
 // merge whatever it says.
 float imageGuideProbability(const RenderSettings& settings, const GpuScene& gpu);
 // --light-tracing as the image sees it: on only where the light-tracing row compiles (the path tracer,
-// mis, a caster, an emissive triangle, and imageManifoldMode Off), so that renders of other scenes
+// mis, a caster, an emissive triangle, --manifold off or auto), so that renders of other scenes
 // continue and merge whatever it says (and --light-paths with it).
 bool imageLightTracing(const RenderSettings& settings, const GpuScene& gpu);
-// An identity text with its manifold line replaced by imageManifoldMode for `gpu` (a text without one
-// is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
+// An identity text with its manifold line replaced by imageManifoldMode for `gpu` and the identity's own
+// light-tracing, integrator and mode lines (a text without one is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
 // "manifold auto" literally reads as what auto gives for the scene.
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
 // resolveIdentityManifold, the guide-probability line as 0 where guiding is not compiled for the scene

@@ -90,16 +90,17 @@ FeatureSet variantFeatures(const FeatureSet& scene, const RenderSettings& settin
 // cell table holds no other caster's cells, so manifold NEE and its MIS weight skip them alike): every
 // caster under On, those with CausticCaster::manifoldAuto under Auto, none under Off or without emitters.
 std::uint32_t manifoldCasterMask(ManifoldMode m, const GpuScene& g);
-// The settings with --manifold auto decided for the scene: On where manifoldCasterMask(Auto) holds a
-// caster, else Off (the manifold row's settings test reads On; a scene where auto finds no caster
-// compiles the same variant as off); and caster aiming off (casterProbability 0) where light tracing is
-// compiled and the scene has no environment map or punctual light, whose caustics only aiming finds.
-// What the Renderer asks variantFeatures with.
+// The settings with --manifold auto decided for the scene: Off where light tracing compiles (it takes the
+// caustics of emissive triangles), else On where manifoldCasterMask(Auto) holds a caster (the manifold
+// row's settings test reads On; a scene where auto finds no caster compiles the same variant as off), else
+// Off. And caster aiming off (casterProbability 0) where light tracing compiles, unless a caster's emitters
+// look small from it (guideCasterMask) or the scene has an environment map or a punctual light: beside light
+// tracing aiming serves only the caustics it does not take. What the Renderer asks variantFeatures with.
 RenderSettings resolveManifold(RenderSettings s, const GpuScene& g);
-// Whether the light-tracing row compiles for settings `s` (--manifold auto resolved or not) on `g`: the
-// path tracer, mis, --light-tracing on, manifold NEE off, a caster and an emissive triangle. The one test
-// resolveManifold and the accumulation identity (imageLightTracing) share.
-bool lightTracingCompiled(RenderSettings s, const GpuScene& g);
+// Whether the light-tracing row compiles for settings `s` (--manifold auto resolved or not: auto leaves
+// it on) on `g`: the path tracer, mis, --light-tracing on, --manifold not on, a caster and an emissive
+// triangle. The one test resolveManifold and the accumulation identity (imageLightTracing) share.
+bool lightTracingCompiled(const RenderSettings& s, const GpuScene& g);
 // The casters caster guiding sends its photons to: those --manifold auto chooses (smooth, the emitters
 // subtending less than kManifoldAutoSolidAngle from them), where guiding measured a gain; under larger
 // lamps it measured a loss (docs/path-tracer.md). 0: guiding is not compiled.

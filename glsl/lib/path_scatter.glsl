@@ -132,10 +132,17 @@ BounceLobe chooseBounceLobe(inout PathState s, inout Surface sf, vec3 color) {
 // objects (casters.glsl): more paths reach the caustics they focus; the mixture pdf keeps the estimate
 // unbiased and enters MIS. Only at the path's first diffuse vertex (the caustics the camera sees;
 // deeper vertices gain less than they cost, docs/path-tracer.md), and not at the last vertex the depth
-// limit allows. Drawn before the lights' numbers.
+// limit allows. With light tracing, not at a vertex of its family either (a Lambertian vertex the camera
+// sees directly): the light tracer takes the caustics there, and an aimed bounce would mostly find paths
+// the eye path then drops; the caustics seen in a mirror or through glass stay the eye paths' to aim at.
+// Drawn before the lights' numbers.
 vec3 sampleCasterMixture(inout PathState s, Surface sf) {
   float uChoose = rand01(s.rng);
-  if (s.firstDiffuse && nextRayTraced(s)) prepareCasters(sf.p, sf.ns, uChoose);
+  bool aim = s.firstDiffuse && nextRayTraced(s);
+#ifdef CAUSTICA_LIGHT_TRACE
+  aim = aim && !s.ltFamily;
+#endif
+  if (aim) prepareCasters(sf.p, sf.ns, uChoose);
   else gCasterUsable = 0u;
   s.firstDiffuse = false;
   float uPick = rand01(s.rng);

@@ -142,36 +142,53 @@ TEST_CASE("resume from a checkpoint: the identity holds --manifold as the image 
   }
 }
 
-TEST_CASE("resume from a checkpoint: one of --manifold off does not continue auto where auto finds casters, nor auto on where it takes only some") {
-  // lamp-caustics: its small lamp puts both casters under auto, which then renders what on does.
+TEST_CASE("resume from a checkpoint: auto continues off where light tracing takes the caustics; without it, off does not continue auto where auto finds casters, nor auto on where it takes only some") {
+  // lamp-caustics: its small lamp puts both casters under auto's manifold NEE, which light tracing (on by
+  // default) goes before: auto then renders what off does; with --light-tracing off, what on does.
   Scene lamp = loadScene(sourcePath("assets/scenes/lamp-caustics.gltf"));
   const Camera camera = sceneCamera(lamp);
   RenderSettings rs = smallSettings(8, 8, Integrator::Mis, 1), offRs = rs, onRs = rs;
   rs.manifold = ManifoldMode::Auto;
   offRs.manifold = ManifoldMode::Off;
   onRs.manifold = ManifoldMode::On;
+  RenderSettings eyeRs = rs, eyeOffRs = offRs;  // --light-tracing off
+  eyeRs.lightTracing = eyeOffRs.lightTracing = false;
   {
     Renderer renderer(testShaderLibrary(), lamp, camera, rs);
     const GpuScene& gpu = renderer.gpuScene();
-    cli::Checkpoint older;  // an older build's default, --manifold off (without light tracing, which it lacked)
-    RenderSettings olderRs = offRs;
-    olderRs.lightTracing = false;
-    older.identity = cli::accumulationIdentity(cli::ImageSettings{olderRs}, camera);
-    CHECK(cli::checkpointMismatch(older, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) ==
+    CHECK(cli::imageManifoldMode(rs, gpu) == ManifoldMode::Off);
+    CHECK(cli::imageManifoldMode(eyeRs, gpu) == ManifoldMode::On);
+    cli::Checkpoint off;  // --manifold off with light tracing: what auto renders
+    off.identity = cli::accumulationIdentity(cli::ImageSettings{offRs}, camera);
+    CHECK(cli::checkpointMismatch(off, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) == "");
+    cli::Checkpoint before;  // the default of the builds before light tracing went first: manifold NEE
+    before.identity = cli::accumulationIdentity(cli::ImageSettings{eyeRs}, camera, gpu);
+    CHECK(before.identity.find("\nmanifold on\n") != std::string::npos);
+    CHECK(cli::checkpointMismatch(before, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) ==
+          "light-tracing: checkpoint off, this render on; manifold: checkpoint on, this render off");
+    // Without light tracing: an older build's default --manifold off is not what auto renders, on is.
+    cli::Checkpoint older;
+    older.identity = cli::accumulationIdentity(cli::ImageSettings{eyeOffRs}, camera);
+    CHECK(cli::checkpointMismatch(older, 0, cli::accumulationIdentity(cli::ImageSettings{eyeRs}, camera, gpu), &gpu) ==
           "manifold: checkpoint off, this render on");
     cli::Checkpoint on;
     on.identity = cli::accumulationIdentity(cli::ImageSettings{onRs}, camera);
-    CHECK(cli::checkpointMismatch(on, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, gpu), &gpu) == "");
+    CHECK(cli::checkpointMismatch(on, 0, cli::accumulationIdentity(cli::ImageSettings{eyeRs}, camera, gpu), &gpu) == "");
   }
-  // A glass ball far under a small lamp qualifies, a mirror ball beside it does not: auto sends photons
-  // through the glass only, an image neither on nor off renders, so it stays "auto".
+  // A glass ball far under a small lamp qualifies, a mirror ball beside it does not: without light tracing
+  // auto sends photons through the glass only, an image neither on nor off renders, so it stays "auto".
   const Scene s = lampOverGlassAndMirror();
   const GpuScene g = packScene(s, buildBvh(s.triangles));
   REQUIRE(g.casters.size() == 2);
-  CHECK(cli::imageManifoldMode(ManifoldMode::Auto, g) == ManifoldMode::Auto);
+  CHECK(cli::imageManifoldMode(eyeRs, g) == ManifoldMode::Auto);
+  CHECK(cli::imageManifoldMode(rs, g) == ManifoldMode::Off);
   cli::Checkpoint on;
   on.identity = cli::accumulationIdentity(cli::ImageSettings{onRs}, camera);
-  CHECK(cli::checkpointMismatch(on, 0, cli::accumulationIdentity(cli::ImageSettings{rs}, camera, g), &g) ==
+  CHECK(cli::checkpointMismatch(on, 0, cli::accumulationIdentity(cli::ImageSettings{eyeRs}, camera, g), &g) ==
         "manifold: checkpoint on, this render auto");
-  for (ManifoldMode m : {ManifoldMode::On, ManifoldMode::Off}) CHECK(cli::imageManifoldMode(m, g) == m);
+  for (ManifoldMode m : {ManifoldMode::On, ManifoldMode::Off}) {
+    RenderSettings given = rs;
+    given.manifold = m;
+    CHECK(cli::imageManifoldMode(given, g) == m);
+  }
 }

@@ -251,9 +251,10 @@ TEST_CASE("shader features: caster aiming takes glass, and a mirror unless a lar
 }
 
 // Light tracing (docs/path-tracer.md): compiled where a caster and an emissive triangle meet manifold NEE
-// off (--manifold off, or auto resolved off), never beside manifold NEE or naive; where it is, eye paths
-// stop aiming at casters unless an environment map or a punctual light needs it.
-TEST_CASE("shader features: light tracing beside manifold NEE off, and caster aiming stepping aside for it") {
+// not on (--manifold off, or auto: light tracing goes first), never beside manifold NEE or naive; caster
+// aiming stays compiled beside it under small lamps (it aims where the light tracer does not take the
+// caustic). Auto takes manifold NEE only with --light-tracing off.
+TEST_CASE("shader features: light tracing before manifold NEE under auto, never beside it; caster aiming beside it under small lamps") {
   Material glass, light;
   glass.transmission = 1.0f;
   light.emission = glm::vec3(4.0f);
@@ -268,20 +269,22 @@ TEST_CASE("shader features: light tracing beside manifold NEE off, and caster ai
     REQUIRE(scene.has("CAUSTICA_LIGHT_TRACE"));  // the scene's test: a caster and an emitter
     RenderSettings rs;
     const FeatureSet byDefault = variantFeatures(scene, resolveManifold(rs, g));
-    CHECK(byDefault.has("CAUSTICA_LIGHT_TRACE") == (lamp > 0.1f));
-    CHECK(byDefault.has("CAUSTICA_MANIFOLD") == (lamp < 0.1f));
-    CHECK(byDefault.has("CAUSTICA_CASTERS") == (lamp < 0.1f));  // aiming steps aside where light tracing runs
+    CHECK(byDefault.has("CAUSTICA_LIGHT_TRACE"));
+    CHECK_FALSE(byDefault.has("CAUSTICA_MANIFOLD"));
+    CHECK(byDefault.has("CAUSTICA_CASTERS") == (lamp < 0.1f));  // beside it, aiming only under small lamps
     rs.manifold = ManifoldMode::Off;
     const FeatureSet off = variantFeatures(scene, resolveManifold(rs, g));
-    CHECK(off.has("CAUSTICA_LIGHT_TRACE"));
-    CHECK_FALSE(off.has("CAUSTICA_CASTERS"));
+    CHECK(off.defines() == byDefault.defines());
     rs.manifold = ManifoldMode::On;
-    CHECK_FALSE(variantFeatures(scene, resolveManifold(rs, g)).has("CAUSTICA_LIGHT_TRACE"));
-    rs.manifold = ManifoldMode::Off;
+    const FeatureSet on = variantFeatures(scene, resolveManifold(rs, g));
+    CHECK_FALSE(on.has("CAUSTICA_LIGHT_TRACE"));
+    CHECK(on.has("CAUSTICA_MANIFOLD"));
+    rs.manifold = ManifoldMode::Auto;
     rs.lightTracing = false;
-    const FeatureSet eyeOnly = variantFeatures(scene, resolveManifold(rs, g));
-    CHECK_FALSE(eyeOnly.has("CAUSTICA_LIGHT_TRACE"));
-    CHECK(eyeOnly.has("CAUSTICA_CASTERS"));
+    const FeatureSet eyeAuto = variantFeatures(scene, resolveManifold(rs, g));
+    CHECK_FALSE(eyeAuto.has("CAUSTICA_LIGHT_TRACE"));
+    CHECK(eyeAuto.has("CAUSTICA_MANIFOLD") == (lamp < 0.1f));
+    CHECK(eyeAuto.has("CAUSTICA_CASTERS"));
     rs.lightTracing = true;
     rs.integrator = Integrator::Naive;
     CHECK_FALSE(variantFeatures(scene, resolveManifold(rs, g)).has("CAUSTICA_LIGHT_TRACE"));

@@ -92,10 +92,9 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
     const bool unlit = !sceneHasLights(original);
     if (unlit) original.environment = uniformEnvironment(glm::vec3(kDefaultEnvironmentRadiance));
     RenderSettings settings = smallSettings(48, 48, Integrator::Mis, 3);
-    // With the default --manifold auto (manifold NEE on lamp-caustics and mirror-caustic): the caustic
-    // photon pass (the test below) and the light tree (tests/accel/light_tree_test.cpp) are the same at
-    // every transform, so next-event estimation draws the same light samples and manifold NEE solves
-    // from them.
+    // With the default settings (light tracing on every scene with a caster and an emissive triangle): the
+    // caustic photon passes (the test below) and the light tree (tests/accel/light_tree_test.cpp) are the
+    // same at every transform, so next-event estimation and the light subpaths draw the same light samples.
     RenderResult ref = renderScene(original, sceneCamera(original), settings, spp, spp);
     const double refMean = meanOf(ref.image);
     std::vector<PixelRect> regions = {{0, 0, 24, 24}, {24, 0, 48, 24}, {0, 24, 24, 48}, {24, 24, 48, 48}};
@@ -125,7 +124,7 @@ TEST_CASE("stress: every bundled scene scaled by 1e-4..1e4 or moved 1e3..1e5 awa
   MESSAGE("largest deviation of a region's mean: ", worst, " (", worstAt, ")");
 }
 
-// The caustic photon passes of manifold NEE (the default --manifold auto picks it on lamp-caustics) and
+// The caustic photon passes of manifold NEE (--manifold auto picks it on lamp-caustics without light tracing) and
 // of caster guiding send their photons from the same emitter points whatever the scene's scale or place,
 // so they land where they did: the same count and the same cells up to a photon on a cell's edge
 // (measured: manifold NEE's 92,551 photons in 3,689 or 3,690 cells at every transform). Before, the light
@@ -136,7 +135,9 @@ TEST_CASE("stress: the caustic photon pass lands the same photons in the same ce
   for (CellTable table : {CellTable::Manifold, CellTable::Guide}) {
     const char* name = table == CellTable::Guide ? "guide" : "manifold NEE";
     auto statsOf = [&](const Scene& s) {
-      Renderer r(testShaderLibrary(), s, sceneCamera(s), smallSettings(8, 8));
+      RenderSettings rs = smallSettings(8, 8);
+      rs.lightTracing = false;  // auto's manifold NEE: light tracing goes before it
+      Renderer r(testShaderLibrary(), s, sceneCamera(s), rs);
       r.renderPass(1);
       return r.causticCellStats(table);
     };
