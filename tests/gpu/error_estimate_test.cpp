@@ -292,9 +292,9 @@ TEST_CASE("adaptive sampling: on mirror-caustic the samples go to the mirror's c
   const auto info = readBenchScenes(sourcePath("bench/scenes.json"));
   REQUIRE(info.at("mirror-caustic").caustic);
   RenderSettings rs = smallSettings(64, 64, Integrator::Mis, 7);
-  // Plain mis: under the default --manifold auto, manifold NEE takes the patch's noise away (the
-  // sampler meets its target at its first check, 16 spp), and there is nothing left to allocate; so
-  // does caster guiding, and light tracing, which --manifold off would compile.
+  // Plain mis: the default's light tracing takes the patch's noise away (as manifold NEE did: the sampler
+  // met its target at its first check, 16 spp), and there is nothing left to allocate; so does caster
+  // guiding.
   rs.manifold = ManifoldMode::Off;
   rs.guideProbability = 0.0f;
   rs.lightTracing = false;

@@ -884,6 +884,20 @@ TEST_CASE("light tracing is unbiased: mirror-caustic, caster aiming beside it") 
   checkLightTracingUnbiased("mirror-caustic", mirror, patch, 1.0f);
 }
 
+// The other bundled scenes where it is the default: cornell-dispersion (a dispersive ball lens and prism;
+// rgb, the default) and cornell-materials (coated, sheen and rough materials, whose vertices end the
+// family, beside smooth glass), their caustic regions and images at what a few seconds resolve (printed).
+TEST_CASE("light tracing is unbiased: cornell-dispersion and cornell-materials") {
+  for (const char* name : {"cornell-dispersion", "cornell-materials"}) {
+    Scene scene = loadScene(sourcePath(std::string("assets/scenes/") + name + ".gltf"));
+    const bool disp = std::string(name) == "cornell-dispersion";
+    const ManifoldView region = disp ? causticRegion(scene, 0.30, 0.81, 0.65, 0.94, 512, 1024, 256)
+                                     : causticRegion(scene, 0.36, 0.86, 0.64, 0.97, 512, 1024, 256);
+    checkLightTracingUnbiased(name, scene, region, 1.0f);
+    checkLightTracingUnbiased(name, scene, {"image", sceneCamera(scene), 512, 1024, 256}, 0.125f);
+  }
+}
+
 // The lamp embedded in a glass slab: light subpaths start inside glass and cross into the air, the one
 // crossing an eye path makes the other way. Refraction scales radiance by 1 / eta^2 but not importance:
 // scatterDelta's radiance factor kept would make the focus 2.25x too bright; the eye path's factor for
