@@ -121,8 +121,9 @@ float imageGuideProbability(const RenderSettings& settings, const GpuScene& gpu)
 // continue and merge whatever it says (and --light-paths with it).
 bool imageLightTracing(const RenderSettings& settings, const GpuScene& gpu);
 // An identity text with its manifold line replaced by imageManifoldMode for `gpu` and the identity's own
-// light-tracing, integrator and mode lines (a text without one is returned as it is). Resuming compares both sides through it: a checkpoint that recorded
-// "manifold auto" literally reads as what auto gives for the scene.
+// light-tracing, integrator and mode lines (a text without one, or with a line this build cannot read, is
+// returned as it is). Resuming compares both sides through it: a checkpoint that recorded "manifold auto"
+// literally reads as what auto gives for the scene.
 std::string resolveIdentityManifold(const std::string& identity, const GpuScene& gpu);
 // resolveIdentityManifold, the guide-probability line as 0 where guiding is not compiled for the scene
 // (no caster it applies to, imageGuideProbability), and the light-tracing line as off (light-paths as the

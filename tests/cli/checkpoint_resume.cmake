@@ -76,6 +76,12 @@ refused("lamp-on.exr.ckpt: cannot resume another render: light-tracing: checkpoi
         lamp-caustics --size 16 --backend osmesa -q --spp 4 -o ${DIR}/x.exr --resume ${DIR}/lamp-on.exr.ckpt)
 run(0 lamp-caustics --size 16 --backend osmesa -q --spp 2 --manifold off -o ${DIR}/lamp-off.exr --checkpoint 1000)
 run(0 lamp-caustics --size 16 --backend osmesa -q --spp 4 -o ${DIR}/lamp-resumed.exr --resume ${DIR}/lamp-off.exr.ckpt)
+run(0 lamp-caustics --size 16 --backend osmesa -q --spp 4 -o ${DIR}/lamp-straight.exr)
+file(SHA256 ${DIR}/lamp-resumed.exr lr)
+file(SHA256 ${DIR}/lamp-straight.exr ls)
+if(NOT lr STREQUAL ls)  # light tracing with caster aiming and guiding beside it, all resumed bit for bit
+  message(FATAL_ERROR "lamp-caustics: a checkpoint of --manifold off resumed with the default auto differs from the straight render")
+endif()
 if(EXISTS ${DIR}/x.exr)
   message(FATAL_ERROR "a refused resume wrote an image")
 endif()

@@ -619,21 +619,39 @@ std::vector<std::vector<std::string>> checkViewAgrees(const std::string& what, c
   return variants;
 }
 
-// Manifold NEE against mis without it and against naive (checkViewAgrees).
+// The settings every estimator test below starts from: 16 x 16 pixels, mis, depth 32, `dispersion`.
+RenderSettings estimatorTestSettings(DispersionMode dispersion) {
+  RenderSettings s = smallSettings(16, 16, Integrator::Mis);
+  s.dispersion = dispersion;
+  s.maxDepth = 32;
+  return s;
+}
+
+// An estimator added to mis (manifold NEE, caster guiding, light tracing: `with`, which compiles `define`)
+// against mis without it (`without`, which does not) and against naive from `base` (checkViewAgrees;
+// seeds seedBase, +1000 and +2000; `with` takes the view's sppManifold, `without` its sppMis).
+void checkEstimatorUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view, const char* define,
+                            const RenderSettings& base, const EstimatorRun& with, const EstimatorRun& without,
+                            std::uint32_t seedBase, int longFactor) {
+  RenderSettings naive = base;
+  naive.integrator = Integrator::Naive;
+  const auto variants = checkViewAgrees(what, scene, view, {with.name, with.settings, view.sppManifold, seedBase},
+                                        {{without.name, without.settings, view.sppMis, seedBase + 1000},
+                                         {"naive", naive, view.sppNaive, seedBase + 2000}},
+                                        longFactor);
+  REQUIRE(hasDefine(variants[0], define));
+  REQUIRE_FALSE(hasDefine(variants[1], define));
+}
+
+// Manifold NEE against mis without it and against naive.
 void checkManifoldUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view,
                            DispersionMode dispersion = DispersionMode::Rgb, int longFactor = 4) {
-  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
-  settings.dispersion = dispersion;
-  settings.maxDepth = 32;
+  RenderSettings settings = estimatorTestSettings(dispersion);
   settings.lightTracing = false;  // the eye-path estimators manifold NEE is one of
-  RenderSettings on = settings, off = settings, naive = settings;
+  RenderSettings on = settings, off = settings;
   on.manifold = ManifoldMode::On;
   off.manifold = ManifoldMode::Off;
-  naive.integrator = Integrator::Naive;
-  const auto variants = checkViewAgrees(what, scene, view, {"manifold", on, view.sppManifold, 5000},
-                                        {{"mis", off, view.sppMis, 6000}, {"naive", naive, view.sppNaive, 7000}}, longFactor);
-  REQUIRE(hasDefine(variants[0], "CAUSTICA_MANIFOLD"));
-  REQUIRE_FALSE(hasDefine(variants[1], "CAUSTICA_MANIFOLD"));
+  checkEstimatorUnbiased(what, scene, view, "CAUSTICA_MANIFOLD", settings, {"manifold", on}, {"mis", off}, 5000, longFactor);
 }
 
 // causticScene's focus: the part of its 64 x 64 image within `r` (normalized) of the floor under the ball.
@@ -755,22 +773,16 @@ TEST_CASE("manifold NEE is unbiased: instanced caster") {
 namespace {
 
 // Caster guiding (--guide-probability, glsl/lib/casters.glsl) against the same estimator without it
-// and against naive (checkViewAgrees); manifold NEE as `manifold` says in both.
+// and against naive; manifold NEE as `manifold` says in both.
 void checkGuidingUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view, ManifoldMode manifold,
                           DispersionMode dispersion = DispersionMode::Rgb) {
-  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
-  settings.dispersion = dispersion;
-  settings.maxDepth = 32;
+  RenderSettings settings = estimatorTestSettings(dispersion);
   settings.manifold = manifold;
   settings.lightTracing = false;  // the eye-path estimators guiding is part of
-  RenderSettings guided = settings, unguided = settings, naive = settings;
+  RenderSettings guided = settings, unguided = settings;
   guided.guideProbability = 0.5f;
   unguided.guideProbability = 0.0f;
-  naive.integrator = Integrator::Naive;
-  const auto variants = checkViewAgrees(what, scene, view, {"guided", guided, view.sppManifold, 8000},
-                                        {{"unguided", unguided, view.sppMis, 9000}, {"naive", naive, view.sppNaive, 10000}});
-  REQUIRE(hasDefine(variants[0], "CAUSTICA_GUIDING"));
-  REQUIRE_FALSE(hasDefine(variants[1], "CAUSTICA_GUIDING"));
+  checkEstimatorUnbiased(what, scene, view, "CAUSTICA_GUIDING", settings, {"guided", guided}, {"unguided", unguided}, 8000, 4);
 }
 
 }  // namespace
@@ -808,24 +820,19 @@ TEST_CASE("caster guiding is unbiased: cornell-glass, lamp-caustics, dispersion"
 }
 
 namespace {
-// Light tracing (glsl/light_trace.comp) against mis without it and against naive (checkViewAgrees), with
-// manifold NEE off in all three (light tracing is not compiled beside it). lightPaths: its subpaths per
-// pixel and sample (a crop of the image sees few of them).
+// Light tracing (glsl/light_trace.comp) against mis without it and against naive, with manifold NEE off in
+// all three (light tracing is not compiled beside it). lightPaths: its subpaths per pixel and sample (a crop
+// of the image sees few of them).
 void checkLightTracingUnbiased(const std::string& what, const Scene& scene, const ManifoldView& view, float lightPaths,
                                DispersionMode dispersion = DispersionMode::Rgb, int longFactor = 4) {
-  RenderSettings settings = smallSettings(16, 16, Integrator::Mis);
-  settings.dispersion = dispersion;
-  settings.maxDepth = 32;
+  RenderSettings settings = estimatorTestSettings(dispersion);
   settings.manifold = ManifoldMode::Off;
-  RenderSettings on = settings, off = settings, naive = settings;
+  RenderSettings on = settings, off = settings;
   on.lightTracing = true;
   on.lightPaths = lightPaths;
   off.lightTracing = false;
-  naive.integrator = Integrator::Naive;
-  const auto variants = checkViewAgrees(what, scene, view, {"light tracing", on, view.sppManifold, 11000},
-                                        {{"mis", off, view.sppMis, 12000}, {"naive", naive, view.sppNaive, 13000}}, longFactor);
-  REQUIRE(hasDefine(variants[0], "CAUSTICA_LIGHT_TRACE"));
-  REQUIRE_FALSE(hasDefine(variants[1], "CAUSTICA_LIGHT_TRACE"));
+  checkEstimatorUnbiased(what, scene, view, "CAUSTICA_LIGHT_TRACE", settings, {"light tracing", on}, {"mis", off}, 11000,
+                         longFactor);
 }
 }  // namespace
 
