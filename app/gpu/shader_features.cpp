@@ -97,7 +97,8 @@ const std::vector<ShaderFeature>& shaderFeatureTable() {
        [](const RenderSettings& s) { return s.integrator == Integrator::Mis; }, nullptr, A::Keep},
       {"casters", "CAUSTICA_CASTERS", K::Integrator, "diffuse bounces also aim at glass and mirror objects",
        "mis, a caustic caster to aim at (aimCasterMask: glass, or a mirror no large lamp lights) and "
-       "--caster-probability > 0", nullptr,
+       "--caster-probability > 0; beside light tracing only under small lamps, an environment map or punctual "
+       "lights (resolveManifold)", nullptr,
        [](const SceneView& v) { return aimCasterMask(v.gpu) != 0u; },
        [](const RenderSettings& s) { return s.casterProbability > 0.0f; }, "CAUSTICA_MIS", A::Keep},
       {"guiding", "CAUSTICA_GUIDING", K::Integrator,

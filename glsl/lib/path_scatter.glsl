@@ -132,14 +132,15 @@ BounceLobe chooseBounceLobe(inout PathState s, inout Surface sf, vec3 color) {
 // objects (casters.glsl): more paths reach the caustics they focus; the mixture pdf keeps the estimate
 // unbiased and enters MIS. Only at the path's first diffuse vertex (the caustics the camera sees;
 // deeper vertices gain less than they cost, docs/path-tracer.md), and not at the last vertex the depth
-// limit allows. With light tracing, not at a vertex of its family either (a Lambertian vertex the camera
-// sees directly): the light tracer takes the caustics there, and an aimed bounce would mostly find paths
-// the eye path then drops; the caustics seen in a mirror or through glass stay the eye paths' to aim at.
-// Drawn before the lights' numbers.
+// limit allows. With light tracing and only emissive triangles to light the scene, not at a vertex of its
+// family either (a Lambertian vertex the camera sees directly): the light tracer takes the caustics there,
+// and an aimed bounce would mostly find paths the eye path then drops; the caustics seen in a mirror or
+// through glass stay the eye paths' to aim at. (The environment's and punctual lights' caustics are the eye
+// paths' everywhere: with those, every first diffuse vertex aims.) Drawn before the lights' numbers.
 vec3 sampleCasterMixture(inout PathState s, Surface sf) {
   float uChoose = rand01(s.rng);
   bool aim = s.firstDiffuse && nextRayTraced(s);
-#ifdef CAUSTICA_LIGHT_TRACE
+#if defined(CAUSTICA_LIGHT_TRACE) && !defined(CAUSTICA_ENV) && !defined(CAUSTICA_PUNCTUAL)
   aim = aim && !s.ltFamily;
 #endif
   if (aim) prepareCasters(sf.p, sf.ns, uChoose);
