@@ -20,6 +20,9 @@
 #include "lib/microfacet.glsl"
 #include "lib/materials.glsl"
 #include "lib/lights.glsl"
+#ifdef CAUSTICA_ENV
+#include "lib/environment.glsl"  // environmentPresent (path_scatter.glsl's sampleCasterMixture)
+#endif
 #if defined(CAUSTICA_PUNCTUAL) || defined(CAUSTICA_SPOT_EMITTERS)
 #include "lib/punctual.glsl"
 #endif

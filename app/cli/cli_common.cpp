@@ -128,12 +128,12 @@ std::vector<OptionSpec> sceneOptionSpecs() {
        "picks them; 0 to 1, default 0.5; 0 = off)"},
       {"--manifold", "", "auto|on|off",
        "mis: manifold next-event estimation, light joined to diffuse points through glass and mirror objects "
-       "(caustics of small lights); auto (default) uses it through the objects the lights look small from "
-       "(caustica info lists them), on through all"},
+       "(caustics of small lights); auto (default) uses it only under --light-tracing off, through the objects "
+       "the lights look small from (caustica info lists them); on through all, instead of light tracing"},
       {"--light-tracing", "", "on|off",
        "mis: light subpaths from the emitters through glass and mirror objects add the caustics the camera "
-       "sees on diffuse surfaces (default on; not beside manifold NEE: --manifold on, or auto where it takes a "
-       "caster, takes precedence)"},
+       "sees on diffuse surfaces (default on; not beside manifold NEE: --manifold on takes precedence, auto "
+       "leaves manifold NEE off)"},
       {"--light-paths", "", "R", "light tracing: light subpaths per pixel and sample (1/64 to 64, default 0.125)"},
       {"--camera", "", "N", "use the scene's N-th perspective camera (default 0)"},
       {"--light-radius", "", "R",

@@ -158,7 +158,7 @@ void printFeatures(const Scene& s, const GpuScene& g) {
                 vec(glm::vec3(g.casters[i].sphere)).c_str(), g.casters[i].sphere.w, g.casters[i].emitterSolidAngle,
                 (aimed & (1u << i)) != 0u ? "cone aimed at" : "cone not aimed at",
                 g.casters[i].manifoldAuto ? "on (under --light-tracing off)" : !g.casters[i].smooth ? "off (rough)" : "off");
-  if (!g.casters.empty() && g.emitterCount > 0)  // lightTracingCompiled under the default settings
+  if (lightTracingCompiled(RenderSettings{}, g))
     std::printf("caustics:   light tracing from the emissive triangles (the default; --manifold auto takes manifold NEE "
                 "only under --light-tracing off)\n");
   std::string defines;

@@ -49,8 +49,9 @@ struct RenderSettings {
   float guideProbability = 0.5f;
   // mis only: manifold next-event estimation, which joins the light sample at a path's first diffuse
   // vertex to it through a glass or mirror caster (docs/path-tracer.md); scenes without casters or
-  // emitters never use it. Auto (the default) uses it only through the casters whose emitters look
-  // small from them, and compiles it only where there is one (resolveManifold, shader_features.h).
+  // emitters never use it. Auto (the default) leaves it off where light tracing compiles; otherwise it uses
+  // it only through the casters whose emitters look small from them, and compiles it only where there is
+  // one (resolveManifold, shader_features.h).
   ManifoldMode manifold = ManifoldMode::Auto;
   // mis only: light tracing of caustics: light subpaths from the emitters through glass and mirror objects
   // splat the Lambertian points the camera sees, and take those paths over from the eye paths

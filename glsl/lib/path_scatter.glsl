@@ -140,8 +140,15 @@ BounceLobe chooseBounceLobe(inout PathState s, inout Surface sf, vec3 color) {
 vec3 sampleCasterMixture(inout PathState s, Surface sf) {
   float uChoose = rand01(s.rng);
   bool aim = s.firstDiffuse && nextRayTraced(s);
-#if defined(CAUSTICA_LIGHT_TRACE) && !defined(CAUSTICA_ENV) && !defined(CAUSTICA_PUNCTUAL)
-  aim = aim && !s.ltFamily;
+#ifdef CAUSTICA_LIGHT_TRACE
+  bool otherLights = false;  // as resolveManifold tests it: an environment that emits, or a punctual light
+#ifdef CAUSTICA_ENV
+  otherLights = environmentPresent();  // (CAUSTICA_ENV also compiles for a background alone)
+#endif
+#ifdef CAUSTICA_PUNCTUAL
+  otherLights = true;  // compiled only with a punctual light
+#endif
+  aim = aim && (!s.ltFamily || otherLights);
 #endif
   if (aim) prepareCasters(sf.p, sf.ns, uChoose);
   else gCasterUsable = 0u;
